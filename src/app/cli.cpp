@@ -1,7 +1,7 @@
 #include "mpmcd/app/cli.hpp"
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/version.hpp"

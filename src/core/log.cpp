@@ -23,9 +23,15 @@ spdlog::logger& log() {
 void setup_logging(Verbosity verbosity) {
   auto& l = log();
   switch (verbosity) {
-    case Verbosity::kQuiet: l.set_level(spdlog::level::warn); break;
-    case Verbosity::kNormal: l.set_level(spdlog::level::info); break;
-    case Verbosity::kVerbose: l.set_level(spdlog::level::debug); break;
+    case Verbosity::kQuiet:
+      l.set_level(spdlog::level::warn);
+      break;
+    case Verbosity::kNormal:
+      l.set_level(spdlog::level::info);
+      break;
+    case Verbosity::kVerbose:
+      l.set_level(spdlog::level::debug);
+      break;
   }
 }
 

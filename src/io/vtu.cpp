@@ -72,9 +72,9 @@ void VtuPointCloud::write(const std::string& path) const {
       "<DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n",
       blob.size());
   append_block(blob, offsets.data(), offsets.size());
-  header += fmt::format(
-      "<DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{}\"/>\n",
-      blob.size());
+  header +=
+      fmt::format("<DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{}\"/>\n",
+                  blob.size());
   append_block(blob, types.data(), types.size());
   header += "</Cells>\n</Piece>\n</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_";
   std::string text = header;
@@ -89,7 +89,8 @@ void PvdSeries::add(double time, const std::string& relative_file) {
       "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
       "byte_order=\"LittleEndian\">\n<Collection>\n";
   for (const auto& [t, f] : entries_)
-    text += fmt::format("<DataSet timestep=\"{:.17g}\" group=\"\" part=\"0\" file=\"{}\"/>\n", t, f);
+    text +=
+        fmt::format("<DataSet timestep=\"{:.17g}\" group=\"\" part=\"0\" file=\"{}\"/>\n", t, f);
   text += "</Collection>\n</VTKFile>\n";
   write_file_atomic(path_, text);
 }
@@ -105,8 +106,9 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error(fmt::format("cannot rename '{}' to '{}': {}", tmp, path,
-                                               ec.message()));
+  if (ec)
+    throw std::runtime_error(
+        fmt::format("cannot rename '{}' to '{}': {}", tmp, path, ec.message()));
 }
 
 }  // namespace mpmcd::io

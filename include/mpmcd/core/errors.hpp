@@ -41,10 +41,10 @@ class NumericalError : public std::runtime_error {
   NumericalError(const std::string& reason, std::int64_t step = -1, double time = 0.0,
                  std::int64_t grain = -1, std::int64_t point = -1);
 
-  std::int64_t step() const { return step_; }    ///< step index where it happened
-  double time() const { return time_; }          ///< simulation time [s]
-  std::int64_t grain() const { return grain_; }  ///< grain involved, -1 if none
-  std::int64_t point() const { return point_; }  ///< material point involved, -1 if none
+  std::int64_t step() const { return step_; }            ///< step index where it happened
+  double time() const { return time_; }                  ///< simulation time [s]
+  std::int64_t grain() const { return grain_; }          ///< grain involved, -1 if none
+  std::int64_t point() const { return point_; }          ///< material point involved, -1 if none
   const std::string& reason() const { return reason_; }  ///< bare reason without location
 
  private:

@@ -28,8 +28,8 @@ class ScopedStage {
       : timers_(timers), name_(name), start_(std::chrono::steady_clock::now()) {}
   ~ScopedStage() {
     if (timers_)
-      timers_->add(name_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_)
-                              .count());
+      timers_->add(
+          name_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
   }
   ScopedStage(const ScopedStage&) = delete;
   ScopedStage& operator=(const ScopedStage&) = delete;

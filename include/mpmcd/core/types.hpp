@@ -1,6 +1,6 @@
 #pragma once
 /// Fixed-size linear-algebra types shared by every module; the dimension is a template parameter.
-#include <Eigen/Core>
+#include <Eigen/Dense>
 #include <cstdint>
 
 namespace mpmcd {
@@ -25,6 +25,8 @@ constexpr int pair_index(int i, int j) {
 }
 
 /// Kronecker delta.
-constexpr double kron(int i, int j) { return i == j ? 1.0 : 0.0; }
+constexpr double kron(int i, int j) {
+  return i == j ? 1.0 : 0.0;
+}
 
 }  // namespace mpmcd

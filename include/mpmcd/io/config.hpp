@@ -1,6 +1,7 @@
 #pragma once
-/// The validated simulation input as plain data (SI units). Filled by io::load_config (io/config.cpp)
-/// from one TOML file; every key is documented in docs/input.md, generated from the schema registry.
+/// The validated simulation input as plain data (SI units). Filled by io::load_config
+/// (io/config.cpp) from one TOML file; every key is documented in docs/input.md, generated from the
+/// schema registry.
 #include <array>
 #include <cstdint>
 #include <map>
@@ -19,53 +20,54 @@ struct SimulationSection {
 
 /// [grid]: the uniform background grid.
 struct GridSection {
-  std::vector<double> origin;   ///< lower corner of the grid [m], Dim entries
-  std::vector<double> extent;   ///< size of the grid along each axis [m], Dim entries
-  double cell_size = 0.0;       ///< cell edge length h [m]
+  std::vector<double> origin;             ///< lower corner of the grid [m], Dim entries
+  std::vector<double> extent;             ///< size of the grid along each axis [m], Dim entries
+  double cell_size = 0.0;                 ///< cell edge length h [m]
   std::string shape_function = "linear";  ///< "linear" or "ugimp"
 };
 
 /// [[materials]]: a named material, its constitutive law and the law's parameters.
 struct MaterialSection {
-  std::string name;                      ///< name referenced by grains [-]
-  std::string law;                       ///< law name from the materials registry [-]
-  double density = 0.0;                  ///< initial mass density rho0 [kg/m^3]
-  std::map<std::string, double> params;  ///< law parameters by name, SI units (e.g. lambda, mu [Pa])
-  std::int64_t line = 0;                 ///< line of the table in the input (for later errors)
+  std::string name;      ///< name referenced by grains [-]
+  std::string law;       ///< law name from the materials registry [-]
+  double density = 0.0;  ///< initial mass density rho0 [kg/m^3]
+  std::map<std::string, double>
+      params;             ///< law parameters by name, SI units (e.g. lambda, mu [Pa])
+  std::int64_t line = 0;  ///< line of the table in the input (for later errors)
 };
 
 /// Initial velocity field of a grain: v(x) = velocity + gradient (x - center)
 ///   + sine_amplitude * sin(sine_wavevector . (x - origin) + sine_phase).
 struct InitialVelocity {
-  std::vector<double> velocity;          ///< uniform part [m/s], Dim entries (default 0)
-  std::vector<double> gradient;          ///< velocity gradient L, row-major Dim*Dim [1/s] (default 0)
-  double angular_velocity = 0.0;         ///< rigid spin about the grain center (2D) [rad/s]
-  std::vector<double> sine_amplitude;    ///< amplitude of the sine part [m/s], Dim entries
-  std::vector<double> sine_wavevector;   ///< wave vector k of the sine part [rad/m], Dim entries
-  double sine_phase = 0.0;               ///< phase of the sine part [rad]
+  std::vector<double> velocity;        ///< uniform part [m/s], Dim entries (default 0)
+  std::vector<double> gradient;        ///< velocity gradient L, row-major Dim*Dim [1/s] (default 0)
+  double angular_velocity = 0.0;       ///< rigid spin about the grain center (2D) [rad/s]
+  std::vector<double> sine_amplitude;  ///< amplitude of the sine part [m/s], Dim entries
+  std::vector<double> sine_wavevector;  ///< wave vector k of the sine part [rad/m], Dim entries
+  double sine_phase = 0.0;              ///< phase of the sine part [rad]
 };
 
 /// [[grains]]: one grain (a body made of material points).
 struct GrainSection {
-  std::string shape;                  ///< "disk" or "rectangle"
-  std::string material;               ///< material name [-]
-  std::vector<double> center;         ///< disk center [m] (disk)
-  double radius = 0.0;                ///< disk radius [m] (disk)
-  std::vector<double> min_corner;     ///< lower corner [m] (rectangle)
-  std::vector<double> max_corner;     ///< upper corner [m] (rectangle)
-  int points_per_cell = 2;            ///< material points per cell along each axis [-]
-  InitialVelocity initial;            ///< initial velocity field
-  std::int64_t line = 0;              ///< line of the table in the input
+  std::string shape;               ///< "disk" or "rectangle"
+  std::string material;            ///< material name [-]
+  std::vector<double> center;      ///< disk center [m] (disk)
+  double radius = 0.0;             ///< disk radius [m] (disk)
+  std::vector<double> min_corner;  ///< lower corner [m] (rectangle)
+  std::vector<double> max_corner;  ///< upper corner [m] (rectangle)
+  int points_per_cell = 2;         ///< material points per cell along each axis [-]
+  InitialVelocity initial;         ///< initial velocity field
+  std::int64_t line = 0;           ///< line of the table in the input
 };
 
 /// [[boundary]]: prescribed nodal velocity components on a set of grid nodes.
 struct BoundarySection {
-  std::string nodes;                 ///< "xmin","xmax","ymin","ymax","zmin","zmax","all" or "box"
-  std::vector<double> box_min;       ///< lower corner of the node box [m] (nodes = "box")
-  std::vector<double> box_max;       ///< upper corner of the node box [m] (nodes = "box")
-  std::vector<std::string> fix;      ///< prescribed components: subset of "x","y","z"
-  std::vector<double> velocity;      ///< prescribed velocity [m/s], Dim entries (free ones ignored)
-  std::int64_t line = 0;             ///< line of the table in the input
+  std::string nodes;             ///< "xmin","xmax","ymin","ymax","zmin","zmax","all" or "box"
+  std::vector<double> box_min;   ///< lower corner of the node box [m] (nodes = "box")
+  std::vector<double> box_max;   ///< upper corner of the node box [m] (nodes = "box")
+  std::vector<std::string> fix;  ///< prescribed components: subset of "x","y","z"
+  std::vector<double> velocity;  ///< prescribed velocity [m/s], Dim entries (free ones ignored)
+  std::int64_t line = 0;         ///< line of the table in the input
 };
 
 /// [loads]: body forces.
@@ -85,22 +87,22 @@ struct TimeSection {
 
 /// [solver]: Newton-Raphson and linear solver settings.
 struct SolverSection {
-  int max_iterations = 25;            ///< Newton iterations before the step is declared failed [-]
-  double residual_tolerance = 1e-10;  ///< relative residual tolerance [-]
-  double increment_tolerance = 1e-10; ///< relative velocity-increment tolerance [-]
-  std::string linear_solver = "ldlt"; ///< "ldlt" (sparse direct), "lu" or "cg" (Jacobi CG)
-  double cg_tolerance = 1e-12;        ///< relative residual of the CG solve [-]
-  int cg_max_iterations = 1000;       ///< CG iteration limit [-]
-  double flip = 1.0;                  ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
+  int max_iterations = 25;             ///< Newton iterations before the step is declared failed [-]
+  double residual_tolerance = 1e-10;   ///< relative residual tolerance [-]
+  double increment_tolerance = 1e-10;  ///< relative velocity-increment tolerance [-]
+  std::string linear_solver = "ldlt";  ///< "ldlt" (sparse direct), "lu" or "cg" (Jacobi CG)
+  double cg_tolerance = 1e-12;         ///< relative residual of the CG solve [-]
+  int cg_max_iterations = 1000;        ///< CG iteration limit [-]
+  double flip = 1.0;  ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
 };
 
 /// [output]: where and how often to write.
 struct OutputSection {
-  std::string folder = "output";  ///< output folder (created) [-]
-  double vtu_interval = 0.0;      ///< simulated time between VTU snapshots [s], 0 = every step
-  double csv_interval = 0.0;      ///< simulated time between CSV rows [s], 0 = every step
-  bool vtu = true;                ///< write VTU/PVD files [-]
-  double progress_interval = 2.0; ///< wall time between progress lines [s]
+  std::string folder = "output";   ///< output folder (created) [-]
+  double vtu_interval = 0.0;       ///< simulated time between VTU snapshots [s], 0 = every step
+  double csv_interval = 0.0;       ///< simulated time between CSV rows [s], 0 = every step
+  bool vtu = true;                 ///< write VTU/PVD files [-]
+  double progress_interval = 2.0;  ///< wall time between progress lines [s]
 };
 
 /// The whole validated input.

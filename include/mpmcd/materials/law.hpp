@@ -15,12 +15,12 @@ namespace mpmcd::materials {
 /// history spans have length n * history_size(); optional outputs may be empty spans).
 template <int Dim>
 struct LawBatch {
-  std::span<const Mat<Dim>> F;           ///< deformation gradient F (plane strain: F33 = 1) [-]
-  std::span<const double> history_old;   ///< committed history variables (law-specific units)
-  std::span<double> history_new;         ///< trial history variables written by the law
-  std::span<Mat<Dim>> sigma;             ///< out: Cauchy stress [Pa]
-  std::span<Tensor4<Dim>> tangent;       ///< out (optional): spatial tangent a = c_mat + c_geo [Pa]
-  std::span<double> energy;              ///< out (optional): stored energy per reference volume [J/m^3]
+  std::span<const Mat<Dim>> F;          ///< deformation gradient F (plane strain: F33 = 1) [-]
+  std::span<const double> history_old;  ///< committed history variables (law-specific units)
+  std::span<double> history_new;        ///< trial history variables written by the law
+  std::span<Mat<Dim>> sigma;            ///< out: Cauchy stress [Pa]
+  std::span<Tensor4<Dim>> tangent;      ///< out (optional): spatial tangent a = c_mat + c_geo [Pa]
+  std::span<double> energy;  ///< out (optional): stored energy per reference volume [J/m^3]
 };
 
 /// A constitutive law. The tangent returned is the spatial (Eulerian) tangent
@@ -58,9 +58,9 @@ struct ParamSpec {
 
 /// Registry entry: a law's name, description and parameters (all required).
 struct LawInfo {
-  std::string name;              ///< registry name, e.g. "neo_hookean"
-  std::string description;      ///< one line, with the equation it implements
-  std::vector<ParamSpec> params; ///< its parameters
+  std::string name;               ///< registry name, e.g. "neo_hookean"
+  std::string description;        ///< one line, with the equation it implements
+  std::vector<ParamSpec> params;  ///< its parameters
 };
 
 /// All registered laws, in documentation order.

@@ -9,21 +9,24 @@ namespace mpmcd::points {
 /// Positions [m] and initial volumes [m^Dim] (per unit thickness in 2D) of seeded points.
 template <int Dim>
 struct Seeds {
-  std::vector<Vec<Dim>> x;      ///< point positions [m]
-  std::vector<double> volume;   ///< point volumes [m^Dim]
+  std::vector<Vec<Dim>> x;     ///< point positions [m]
+  std::vector<double> volume;  ///< point volumes [m^Dim]
 };
 
 /// Lattice spacing of `ppc` points per cell of size `h` [m].
-inline double lattice_spacing(double h, int ppc) { return h / ppc; }
+inline double lattice_spacing(double h, int ppc) {
+  return h / ppc;
+}
 
 /// Seeds a disk (2D) / ball (3D) of `center` [m] and `radius` [m]: lattice sites
-/// x = origin + (i + 1/2) h/ppc that lie strictly inside; volumes are scaled so that their sum equals
-/// the exact area pi r^2 (volume 4/3 pi r^3). Empty if no site falls inside.
+/// x = origin + (i + 1/2) h/ppc that lie strictly inside; volumes are scaled so that their sum
+/// equals the exact area pi r^2 (volume 4/3 pi r^3). Empty if no site falls inside.
 template <int Dim>
 Seeds<Dim> seed_ball(const Vec<Dim>& origin, double h, int ppc, const Vec<Dim>& center,
                      double radius);
 
-/// Seeds the box [lo, hi] [m] with the lattice sites inside; volumes scaled to the exact box volume.
+/// Seeds the box [lo, hi] [m] with the lattice sites inside; volumes scaled to the exact box
+/// volume.
 template <int Dim>
 Seeds<Dim> seed_box(const Vec<Dim>& origin, double h, int ppc, const Vec<Dim>& lo,
                     const Vec<Dim>& hi);
