@@ -20,7 +20,8 @@ struct LawBatch {
   std::span<double> history_new;        ///< trial history variables written by the law
   std::span<Mat<Dim>> sigma;            ///< out: Cauchy stress [Pa]
   std::span<Tensor4<Dim>> tangent;      ///< out (optional): spatial tangent a = c_mat + c_geo [Pa]
-  std::span<double> energy;  ///< out (optional): stored energy per reference volume [J/m^3]
+  std::span<double> energy;    ///< out (optional): stored energy per reference volume [J/m^3]
+  std::span<double> sigma_zz;  ///< out (optional, 2D): out-of-plane Cauchy stress [Pa]
 };
 
 /// A constitutive law. The tangent returned is the spatial (Eulerian) tangent

@@ -33,6 +33,7 @@ class NeoHookean final : public Law<Dim> {
       const Mat<Dim> sigma =
           (mu_ * (b - Mat<Dim>::Identity()) + lambda_ * lnJ * Mat<Dim>::Identity()) / J;
       batch.sigma[p] = sigma;
+      if (!batch.sigma_zz.empty()) batch.sigma_zz[p] = lambda_ * lnJ / J;  // b33 = 1
       if (want_energy)
         batch.energy[p] = 0.5 * mu_ * (b.trace() - Dim) - mu_ * lnJ + 0.5 * lambda_ * lnJ * lnJ;
       if (want_tangent) {
@@ -74,6 +75,7 @@ class SaintVenantKirchhoff final : public Law<Dim> {
       const Mat<Dim> S = lambda_ * E.trace() * Mat<Dim>::Identity() + 2.0 * mu_ * E;
       const Mat<Dim> sigma = F * S * F.transpose() / J;
       batch.sigma[p] = sigma;
+      if (!batch.sigma_zz.empty()) batch.sigma_zz[p] = lambda_ * E.trace() / J;  // E33 = 0
       if (!batch.energy.empty())
         batch.energy[p] = 0.5 * lambda_ * E.trace() * E.trace() + mu_ * E.squaredNorm();
       if (!batch.tangent.empty()) {
@@ -115,6 +117,7 @@ class LinearElastic final : public Law<Dim> {
       const Mat<Dim> eps = 0.5 * (F + F.transpose()) - Mat<Dim>::Identity();
       const Mat<Dim> sigma = lambda_ * eps.trace() * Mat<Dim>::Identity() + 2.0 * mu_ * eps;
       batch.sigma[p] = sigma;
+      if (!batch.sigma_zz.empty()) batch.sigma_zz[p] = lambda_ * eps.trace();  // eps33 = 0
       if (!batch.energy.empty())
         batch.energy[p] = 0.5 * lambda_ * eps.trace() * eps.trace() + mu_ * eps.squaredNorm();
       if (!batch.tangent.empty()) {

@@ -1,0 +1,624 @@
+#include "mpmcd/mpm/solver.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "mpmcd/core/errors.hpp"
+
+namespace mpmcd::mpm {
+
+LinearSolverKind linear_solver_from_string(const std::string& name) {
+  if (name == "ldlt") return LinearSolverKind::kLdlt;
+  if (name == "lu") return LinearSolverKind::kLu;
+  if (name == "cg") return LinearSolverKind::kCg;
+  throw InputError("", 0, "solver.linear_solver",
+                   "expected \"ldlt\", \"lu\" or \"cg\", got \"" + name + "\"");
+}
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+/// Per-grain work space: the grain's own nodal field on a box of nodes (multi-field, method.md §1),
+/// the shape functions of its points at x^n, the block-stencil tangent and its sparse solver.
+template <int Dim>
+struct ImplicitSolver<Dim>::GrainWork {
+  IVec<Dim> box_lo, box_n;                  // node box [lo, lo + n)
+  std::vector<std::int32_t> box_to_active;  // box node -> active node (-1: no mass)
+  std::vector<double> box_m;                // scratch P2G accumulators on the box
+  std::vector<Vec<Dim>> box_mv, box_f, box_fext;
+  std::vector<std::int64_t> node_global;  // active node -> global node index
+  std::vector<IVec<Dim>> node_box;        // active node -> box coordinates
+  std::vector<double> m;                  // lumped mass m_I [kg]
+  std::vector<Vec<Dim>> v_p2g;            // v_I^n from P2G (FLIP increment reference) [m/s]
+  std::vector<Vec<Dim>> v_n;              // v_I^n with boundary values [m/s]
+  std::vector<Vec<Dim>> v;                // current iterate of v_I^{n+1} [m/s]
+  std::vector<Vec<Dim>> f_n, f_ext, f_int, R, du;
+  std::vector<std::uint8_t> mask;         // prescribed components
+  std::vector<IVec<Dim>> pt_first;        // per point: first support node (box coordinates)
+  std::vector<std::int32_t> pt_node;      // per point x K: active node or -1
+  std::vector<double> pt_N;               // per point x K: weights at x^n
+  std::vector<Vec<Dim>> pt_dN;            // per point x K: gradients at x^n [1/m]
+  int K = 0, S = 0, radius = 0;           // support size, stencil size, stencil radius
+  std::vector<std::int32_t> pair_slot;    // K x K: stencil slot of node b seen from node a
+  std::vector<std::int32_t> stencil_nb;   // active x S: neighbour active node or -1
+  std::vector<Mat<Dim>> K_blk;            // active x S: tangent blocks K_ab [N/m]
+  SpMat A;                                // Newton matrix M + theta^2 dt^2 K
+  std::vector<std::int64_t> value_index;  // (active x S x Dim x Dim) -> A.valuePtr() index
+  Eigen::SimplicialLDLT<SpMat> ldlt;
+  Eigen::SparseLU<SpMat> lu;
+  Eigen::ConjugateGradient<SpMat, Eigen::Lower | Eigen::Upper> cg;
+  Eigen::VectorXd rhs, sol;
+  // Newton bookkeeping.
+  bool converged = false, solved_once = false;
+  int iterations = 0;
+  std::int64_t solves = 0;
+  double res_norm = 0, res_ref = 0, dv_norm = 0;
+  std::vector<double> history;  // |R| / reference per iteration
+  std::string failure;
+  std::int64_t fail_point = -1;
+};
+
+template <int Dim>
+ImplicitSolver<Dim>::ImplicitSolver(const grid::Grid<Dim>& grid, const Settings<Dim>& settings,
+                                    points::PointSet<Dim>& points,
+                                    const std::vector<points::Grain>& grains,
+                                    std::vector<const materials::Law<Dim>*> laws)
+    : grid_(grid), settings_(settings), points_(points), grains_(grains), laws_(std::move(laws)) {
+  bc_mask_.assign(static_cast<std::size_t>(grid_.node_count()), 0);
+  for (int d = 0; d < Dim; ++d) bc_set_[d].assign(bc_mask_.size(), -1);
+}
+
+template <int Dim>
+ImplicitSolver<Dim>::~ImplicitSolver() = default;
+
+template <int Dim>
+void ImplicitSolver<Dim>::set_boundary_conditions(const std::vector<VelocityBC<Dim>>& bcs) {
+  bcs_ = bcs;
+  std::fill(bc_mask_.begin(), bc_mask_.end(), 0);
+  for (int d = 0; d < Dim; ++d) std::fill(bc_set_[d].begin(), bc_set_[d].end(), -1);
+  for (std::size_t s = 0; s < bcs_.size(); ++s)
+    for (std::int64_t n : bcs_[s].nodes) {
+      bc_mask_[n] |= bcs_[s].mask;
+      for (int d = 0; d < Dim; ++d)
+        if (bcs_[s].mask & (1u << d)) bc_set_[d][n] = static_cast<std::int32_t>(s);
+    }
+}
+
+namespace {
+template <class T>
+void reset(std::vector<T>& v, std::size_t n, const T& value) {
+  v.assign(n, value);
+}
+}  // namespace
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
+  using Shape = grid::PointShape<Dim, S1>;
+  constexpr int K = Shape::K;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  const std::int64_t np = gr.size();
+  const double h = grid_.cell_size();
+  w.K = K;
+  w.converged = false;
+  w.solved_once = false;
+  w.iterations = 0;
+  w.solves = 0;
+  w.failure.clear();
+  w.fail_point = -1;
+  w.history.clear();
+  w.pt_first.resize(np);
+  w.pt_N.resize(np * K);
+  w.pt_dN.resize(np * K);
+  w.pt_node.resize(np * K);
+  // Pass 1: shape functions at x^n and the node box of the grain.
+  IVec<Dim> lo = IVec<Dim>::Constant(std::numeric_limits<std::int64_t>::max());
+  IVec<Dim> hi = IVec<Dim>::Constant(std::numeric_limits<std::int64_t>::min());
+  Shape ps;
+  for (std::int64_t i = 0; i < np; ++i) {
+    const std::int64_t p = gr.begin + i;
+    ps.eval(points_.x[p], grid_.origin(), h, gr.half_width);
+    w.pt_first[i] = ps.first;
+    for (int a = 0; a < K; ++a) {
+      w.pt_N[i * K + a] = ps.N[a];
+      w.pt_dN[i * K + a] = ps.dN[a];
+    }
+    lo = lo.cwiseMin(ps.first);
+    hi = hi.cwiseMax(ps.first + IVec<Dim>::Constant(S1::kNodes - 1));
+    if ((ps.first.array() < 0).any() ||
+        ((ps.first.array() + S1::kNodes - 1) >= grid_.nodes_per_axis().array()).any() ||
+        !points_.x[p].allFinite()) {
+      w.failure = "material point left the grid";
+      w.fail_point = p;
+      return;
+    }
+  }
+  if (np == 0) return;
+  w.box_lo = lo;
+  w.box_n = hi - lo + IVec<Dim>::Ones();
+  const std::size_t nb = static_cast<std::size_t>(w.box_n.prod());
+  IVec<Dim> stride;
+  stride[0] = 1;
+  for (int d = 1; d < Dim; ++d) stride[d] = stride[d - 1] * w.box_n[d - 1];
+  reset(w.box_m, nb, 0.0);
+  reset(w.box_mv, nb, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.box_f, nb, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.box_fext, nb, Vec<Dim>(Vec<Dim>::Zero()));
+  // Pass 2: P2G (method.md §2): m_I = sum N m_p, m_I v_I = sum N m_p v_p,
+  // f_I^n = -sum V_p sigma_p grad N_I (seed eq. 5) + sum N m_p g.
+  for (std::int64_t i = 0; i < np; ++i) {
+    const std::int64_t p = gr.begin + i;
+    const IVec<Dim> base = w.pt_first[i] - lo;
+    const double mp = points_.mass[p];
+    const Vec<Dim> mv = mp * points_.v[p];
+    const Vec<Dim> mg = mp * settings_.gravity;
+    const Mat<Dim> Vs = points_.volume[p] * points_.sigma[p];
+    for (int a = 0; a < K; ++a) {
+      IVec<Dim> c = base;
+      for (int d = 0; d < Dim; ++d) c[d] += Shape::offset(a, d);
+      const std::int64_t b = c.dot(stride);
+      const double N = w.pt_N[i * K + a];
+      w.box_m[b] += N * mp;
+      w.box_mv[b] += N * mv;
+      w.box_f[b] -= Vs * w.pt_dN[i * K + a];
+      w.box_fext[b] += N * mg;
+    }
+  }
+  // Active nodes: those carrying mass.
+  reset(w.box_to_active, nb, std::int32_t{-1});
+  w.node_global.clear();
+  w.node_box.clear();
+  w.m.clear();
+  w.v_p2g.clear();
+  w.f_n.clear();
+  w.f_ext.clear();
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (!(w.box_m[b] > 0.0)) continue;
+    w.box_to_active[b] = static_cast<std::int32_t>(w.m.size());
+    IVec<Dim> c;
+    std::int64_t r = static_cast<std::int64_t>(b);
+    for (int d = 0; d < Dim; ++d) {
+      c[d] = r % w.box_n[d];
+      r /= w.box_n[d];
+    }
+    w.node_box.push_back(c);
+    w.node_global.push_back(grid_.node_index(c + lo));
+    w.m.push_back(w.box_m[b]);
+    w.v_p2g.push_back(w.box_mv[b] / w.box_m[b]);
+    w.f_n.push_back(w.box_f[b] + w.box_fext[b]);
+    w.f_ext.push_back(w.box_fext[b]);
+  }
+  const std::size_t na = w.m.size();
+  for (std::int64_t i = 0; i < np; ++i) {
+    const IVec<Dim> base = w.pt_first[i] - lo;
+    for (int a = 0; a < K; ++a) {
+      IVec<Dim> c = base;
+      for (int d = 0; d < Dim; ++d) c[d] += Shape::offset(a, d);
+      w.pt_node[i * K + a] = w.box_to_active[c.dot(stride)];
+    }
+  }
+  // Boundary conditions: prescribed components of v^n (for the increment) and v^{n+1}.
+  w.mask.assign(na, 0);
+  w.v_n = w.v_p2g;
+  for (std::size_t a = 0; a < na; ++a) {
+    const std::int64_t n = w.node_global[a];
+    const std::uint8_t mk = bc_mask_[n];
+    if (!mk) continue;
+    w.mask[a] = mk;
+    const Vec<Dim> xn = grid_.node_position(w.node_box[a] + lo);
+    for (int d = 0; d < Dim; ++d)
+      if (mk & (1u << d)) w.v_n[a][d] = bcs_[bc_set_[d][n]].value(xn)[d];
+  }
+  w.v = w.v_n;  // initial guess: zero acceleration
+  reset(w.f_int, na, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.R, na, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.du, na, Vec<Dim>(Vec<Dim>::Zero()));
+  (void)dt;
+  // Stencil of the tangent: node b couples to node a if |c_b - c_a| <= radius per axis.
+  w.radius = S1::kNodes - 1;
+  const int width = 2 * w.radius + 1;
+  w.S = 1;
+  for (int d = 0; d < Dim; ++d) w.S *= width;
+  w.pair_slot.resize(K * K);
+  for (int a = 0; a < K; ++a)
+    for (int b = 0; b < K; ++b) {
+      int slot = 0, mul = 1;
+      for (int d = 0; d < Dim; ++d) {
+        slot += (Shape::offset(b, d) - Shape::offset(a, d) + w.radius) * mul;
+        mul *= width;
+      }
+      w.pair_slot[a * K + b] = slot;
+    }
+  w.stencil_nb.assign(na * w.S, -1);
+  for (std::size_t a = 0; a < na; ++a)
+    for (int s = 0; s < w.S; ++s) {
+      IVec<Dim> c = w.node_box[a];
+      int r = s;
+      bool inside = true;
+      for (int d = 0; d < Dim; ++d) {
+        c[d] += r % width - w.radius;
+        r /= width;
+        if (c[d] < 0 || c[d] >= w.box_n[d]) inside = false;
+      }
+      if (inside) w.stencil_nb[a * w.S + s] = w.box_to_active[c.dot(stride)];
+    }
+  w.K_blk.resize(na * w.S);
+  // Sparse pattern of the Newton matrix and the map from stencil blocks to stored values.
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(na * w.S * Dim * Dim);
+  for (std::size_t a = 0; a < na; ++a)
+    for (int s = 0; s < w.S; ++s) {
+      const std::int32_t b = w.stencil_nb[a * w.S + s];
+      if (b < 0) continue;
+      for (int i = 0; i < Dim; ++i)
+        for (int j = 0; j < Dim; ++j) trip.emplace_back(a * Dim + i, b * Dim + j, 0.0);
+    }
+  const auto ndof = static_cast<Eigen::Index>(na * Dim);
+  w.A.resize(ndof, ndof);
+  w.A.setFromTriplets(trip.begin(), trip.end());
+  w.A.makeCompressed();
+  w.value_index.assign(na * w.S * Dim * Dim, -1);
+  const int* outer = w.A.outerIndexPtr();
+  const int* inner = w.A.innerIndexPtr();
+  for (std::size_t a = 0; a < na; ++a)
+    for (int s = 0; s < w.S; ++s) {
+      const std::int32_t b = w.stencil_nb[a * w.S + s];
+      if (b < 0) continue;
+      for (int i = 0; i < Dim; ++i)
+        for (int j = 0; j < Dim; ++j) {
+          const int col = b * Dim + j, row = static_cast<int>(a) * Dim + i;
+          const int* pos = std::lower_bound(inner + outer[col], inner + outer[col + 1], row);
+          w.value_index[((a * w.S + s) * Dim + i) * Dim + j] = pos - inner;
+        }
+    }
+  if (settings_.linear_solver == LinearSolverKind::kLdlt) w.ldlt.analyzePattern(w.A);
+  if (settings_.linear_solver == LinearSolverKind::kLu) w.lu.analyzePattern(w.A);
+}
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
+  using Shape = grid::PointShape<Dim, S1>;
+  constexpr int K = Shape::K;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  const std::int64_t np = gr.size();
+  const std::size_t na = w.m.size();
+  const double theta = settings_.theta;
+  // Nodal increment du_I = dt [(1 - theta) v_I^n + theta v_I^{n+1}] (method.md §2).
+  for (std::size_t a = 0; a < na; ++a) w.du[a] = dt * ((1.0 - theta) * w.v_n[a] + theta * w.v[a]);
+  // Kinematics: dF = I + sum du_I (x) grad N_I(x^n), F^{n+1} = dF F^n, V^{n+1} = J V^0.
+  for (std::int64_t i = 0; i < np; ++i) {
+    const std::int64_t p = gr.begin + i;
+    Mat<Dim> dF = Mat<Dim>::Identity();
+    for (int a = 0; a < K; ++a) {
+      const std::int32_t n = w.pt_node[i * K + a];
+      if (n >= 0) dF += w.du[n] * w.pt_dN[i * K + a].transpose();
+    }
+    F_trial_[p] = dF * points_.F[p];
+    const double J = F_trial_[p].determinant();
+    J_trial_[p] = J;
+    if (!(J > 0.0) || !std::isfinite(J)) {
+      w.failure = fmt::format("J = {:.3g} <= 0 (inverted material point)", J);
+      w.fail_point = p;
+      return;
+    }
+    dF_inv_T_[p] = dF.inverse().transpose();
+  }
+  const materials::Law<Dim>& law = *laws_[gr.material];
+  const auto off = static_cast<std::size_t>(gr.begin);
+  const auto cnt = static_cast<std::size_t>(np);
+  const std::size_t hs = static_cast<std::size_t>(law.history_size());
+  materials::LawBatch<Dim> batch{
+      std::span<const Mat<Dim>>(F_trial_.data() + off, cnt),
+      std::span<const double>(points_.history.data() + gr.history_offset, hs * cnt),
+      std::span<double>(history_trial_.data() + gr.history_offset, hs * cnt),
+      std::span<Mat<Dim>>(sigma_trial_.data() + off, cnt),
+      std::span<Tensor4<Dim>>(tangent_.data() + off, cnt),
+      {},
+      Dim == 2 ? std::span<double>(sigma_zz_trial_.data() + off, cnt) : std::span<double>()};
+  law.evaluate(batch);
+  // Internal force f_I = -sum V sigma grad_{x^{n+1}} N_I with grad_{x^{n+1}} N = dF^-T grad_{x^n}
+  // N, and tangent blocks K_IJ,ik = sum V g_I,j a_ijkl g_J,l (material + geometric, method.md §2).
+  std::fill(w.f_int.begin(), w.f_int.end(), Vec<Dim>::Zero());
+  std::fill(w.K_blk.begin(), w.K_blk.end(), Mat<Dim>::Zero());
+  Vec<Dim> gx[K];
+  Eigen::Matrix<double, Dim, Dim * Dim> Ma[K];
+  for (std::int64_t i = 0; i < np; ++i) {
+    const std::int64_t p = gr.begin + i;
+    const Mat<Dim>& sig = sigma_trial_[p];
+    if (!sig.allFinite()) {
+      w.failure = "non-finite stress";
+      w.fail_point = p;
+      return;
+    }
+    const double V = J_trial_[p] * points_.volume0[p];
+    const Tensor4<Dim>& T = tangent_[p];
+    for (int a = 0; a < K; ++a) {
+      gx[a] = dF_inv_T_[p] * w.pt_dN[i * K + a];
+      const std::int32_t n = w.pt_node[i * K + a];
+      if (n < 0) continue;
+      w.f_int[n] -= V * (sig * gx[a]);
+      // Ma(i, kl) = V sum_j g_j a(ij, kl)
+      for (int ii = 0; ii < Dim; ++ii)
+        for (int kl = 0; kl < Dim * Dim; ++kl) {
+          double acc = 0;
+          for (int j = 0; j < Dim; ++j) acc += gx[a][j] * T(ii * Dim + j, kl);
+          Ma[a](ii, kl) = V * acc;
+        }
+    }
+    for (int a = 0; a < K; ++a) {
+      const std::int32_t na_ = w.pt_node[i * K + a];
+      if (na_ < 0) continue;
+      Mat<Dim>* row = &w.K_blk[static_cast<std::size_t>(na_) * w.S];
+      for (int b = 0; b < K; ++b) {
+        if (w.pt_node[i * K + b] < 0) continue;
+        Mat<Dim>& blk = row[w.pair_slot[a * K + b]];
+        for (int ii = 0; ii < Dim; ++ii)
+          for (int k = 0; k < Dim; ++k) {
+            double acc = 0;
+            for (int l = 0; l < Dim; ++l) acc += Ma[a](ii, k * Dim + l) * gx[b][l];
+            blk(ii, k) += acc;
+          }
+      }
+    }
+  }
+  // Residual R_I = m_I (v^{n+1} - v^n) - dt [(1 - theta) f^n + theta f^{n+1}] (method.md §2).
+  double r2 = 0, mv2 = 0, fn2 = 0, fi2 = 0, fe2 = 0;
+  for (std::size_t a = 0; a < na; ++a) {
+    Vec<Dim> r = w.m[a] * (w.v[a] - w.v_n[a]) -
+                 dt * ((1.0 - theta) * w.f_n[a] + theta * (w.f_int[a] + w.f_ext[a]));
+    for (int d = 0; d < Dim; ++d)
+      if (w.mask[a] & (1u << d)) r[d] = 0.0;
+    w.R[a] = r;
+    r2 += r.squaredNorm();
+    mv2 += (w.m[a] * w.v_n[a]).squaredNorm();
+    fn2 += w.f_n[a].squaredNorm();
+    fi2 += w.f_int[a].squaredNorm();
+    fe2 += w.f_ext[a].squaredNorm();
+  }
+  w.res_norm = std::sqrt(r2);
+  w.res_ref = std::sqrt(mv2) + dt * (std::sqrt(fn2) + std::sqrt(fi2) + std::sqrt(fe2));
+  if (!std::isfinite(w.res_norm)) {
+    w.failure = "non-finite residual";
+    return;
+  }
+  const double rel = w.res_ref > 0 ? w.res_norm / w.res_ref : 0.0;
+  w.history.push_back(rel);
+  double vmax = 0;
+  for (std::size_t a = 0; a < na; ++a) vmax = std::max(vmax, w.v[a].cwiseAbs().maxCoeff());
+  const bool res_ok = w.res_norm <= settings_.residual_tolerance * w.res_ref;
+  const bool inc_ok = !w.solved_once || w.dv_norm <= settings_.increment_tolerance * vmax;
+  w.converged = res_ok && inc_ok;
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt) {
+  GrainWork& w = *work_[g];
+  const std::size_t na = w.m.size();
+  const double c = settings_.theta * settings_.theta * dt * dt;
+  double* val = w.A.valuePtr();
+  // Newton matrix dR/dv^{n+1} = M + theta^2 dt^2 K (method.md §2); prescribed rows and columns
+  // are replaced by m_I on the diagonal so the matrix stays symmetric positive definite.
+  const int center = (w.S - 1) / 2;
+  for (std::size_t a = 0; a < na; ++a)
+    for (int s = 0; s < w.S; ++s) {
+      const std::int32_t b = w.stencil_nb[a * w.S + s];
+      if (b < 0) continue;
+      const Mat<Dim>& K = w.K_blk[a * w.S + s];
+      for (int i = 0; i < Dim; ++i)
+        for (int j = 0; j < Dim; ++j) {
+          double v = c * K(i, j);
+          if (s == center && i == j) v += w.m[a];
+          const bool fixed_row = w.mask[a] & (1u << i);
+          const bool fixed_col = w.mask[b] & (1u << j);
+          if (fixed_row || fixed_col) v = (s == center && i == j) ? w.m[a] : 0.0;
+          val[w.value_index[((a * w.S + s) * Dim + i) * Dim + j]] = v;
+        }
+    }
+  w.rhs.resize(static_cast<Eigen::Index>(na * Dim));
+  for (std::size_t a = 0; a < na; ++a)
+    for (int d = 0; d < Dim; ++d) w.rhs[a * Dim + d] = -w.R[a][d];
+  bool ok = true;
+  switch (settings_.linear_solver) {
+    case LinearSolverKind::kLdlt:
+      w.ldlt.factorize(w.A);
+      ok = w.ldlt.info() == Eigen::Success;
+      if (ok) w.sol = w.ldlt.solve(w.rhs);
+      break;
+    case LinearSolverKind::kLu:
+      w.lu.factorize(w.A);
+      ok = w.lu.info() == Eigen::Success;
+      if (ok) w.sol = w.lu.solve(w.rhs);
+      break;
+    case LinearSolverKind::kCg:
+      w.cg.setTolerance(settings_.cg_tolerance);
+      w.cg.setMaxIterations(settings_.cg_max_iterations);
+      w.cg.compute(w.A);
+      w.sol = w.cg.solve(w.rhs);
+      ok = w.cg.info() == Eigen::Success;
+      break;
+  }
+  if (!ok || !w.sol.allFinite()) {
+    w.failure = "linear solve failed (singular or indefinite tangent)";
+    return;
+  }
+  double dvmax = 0;
+  for (std::size_t a = 0; a < na; ++a) {
+    const Vec<Dim> dv = w.sol.template segment<Dim>(static_cast<Eigen::Index>(a * Dim));
+    w.v[a] += dv;
+    dvmax = std::max(dvmax, dv.cwiseAbs().maxCoeff());
+  }
+  w.dv_norm = dvmax;
+  w.solved_once = true;
+  ++w.solves;
+}
+
+template <int Dim>
+StepStats ImplicitSolver<Dim>::solve_step(double dt) {
+  StepStats stats;
+  const std::size_t ng = grains_.size();
+  const std::size_t np = points_.size();
+  dt_ = dt;
+  step_ready_ = false;
+  if (work_.size() != ng) {
+    work_.clear();
+    for (std::size_t g = 0; g < ng; ++g) work_.push_back(std::make_unique<GrainWork>());
+  }
+  F_trial_.resize(np);
+  sigma_trial_.resize(np);
+  dF_inv_T_.resize(np);
+  sigma_zz_trial_.resize(np);
+  J_trial_.resize(np);
+  tangent_.resize(np);
+  history_trial_ = points_.history;
+  const bool linear = settings_.shape == grid::ShapeKind::kLinear;
+  auto collect_failure = [&]() {
+    for (std::size_t g = 0; g < ng; ++g)
+      if (!work_[g]->failure.empty()) {
+        stats.failure = work_[g]->failure;
+        stats.grain = static_cast<std::int64_t>(g);
+        stats.point = work_[g]->fail_point;
+        return true;
+      }
+    return false;
+  };
+  {
+    ScopedStage t(&timers_, "p2g");
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::size_t g = 0; g < ng; ++g) {
+      if (linear)
+        setup_grain<grid::Linear1D>(g, dt);
+      else
+        setup_grain<grid::UGimp1D>(g, dt);
+    }
+  }
+  if (collect_failure()) return stats;
+  for (int it = 0; it <= settings_.max_iterations; ++it) {
+    {
+      ScopedStage t(&timers_, "newton.assemble");
+#pragma omp parallel for schedule(dynamic, 1)
+      for (std::size_t g = 0; g < ng; ++g) {
+        GrainWork& w = *work_[g];
+        if (w.converged || !w.failure.empty()) continue;
+        if (linear)
+          evaluate_grain<grid::Linear1D>(g, dt);
+        else
+          evaluate_grain<grid::UGimp1D>(g, dt);
+        if (w.failure.empty()) w.iterations = it;
+      }
+    }
+    if (collect_failure()) return stats;
+    double worst = 0;
+    bool all = true;
+    for (std::size_t g = 0; g < ng; ++g) {
+      if (!work_[g]->history.empty() && static_cast<int>(work_[g]->history.size()) == it + 1)
+        worst = std::max(worst, work_[g]->history.back());
+      all = all && work_[g]->converged;
+    }
+    stats.residual_history.push_back(worst);
+    if (all) {
+      stats.converged = true;
+      break;
+    }
+    if (it == settings_.max_iterations) break;
+    {
+      ScopedStage t(&timers_, "newton.solve");
+#pragma omp parallel for schedule(dynamic, 1)
+      for (std::size_t g = 0; g < ng; ++g) {
+        GrainWork& w = *work_[g];
+        if (!w.converged && w.failure.empty()) solve_grain(g, dt);
+      }
+    }
+    if (collect_failure()) return stats;
+  }
+  for (std::size_t g = 0; g < ng; ++g) {
+    stats.iterations = std::max(stats.iterations, work_[g]->iterations);
+    stats.linear_solves += work_[g]->solves;
+  }
+  if (!stats.converged) {
+    for (std::size_t g = 0; g < ng; ++g)
+      if (!work_[g]->converged) {
+        stats.grain = static_cast<std::int64_t>(g);
+        break;
+      }
+    stats.failure =
+        fmt::format("Newton did not converge in {} iterations (relative residual {:.3e})",
+                    settings_.max_iterations,
+                    stats.residual_history.empty() ? 0.0 : stats.residual_history.back());
+    return stats;
+  }
+  step_ready_ = true;
+  return stats;
+}
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::commit_grain(std::size_t g) {
+  constexpr int K = grid::PointShape<Dim, S1>::K;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  const double alpha = settings_.flip;
+  for (std::int64_t i = 0; i < gr.size(); ++i) {
+    const std::int64_t p = gr.begin + i;
+    Vec<Dim> dx = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero(), vpic = Vec<Dim>::Zero();
+    for (int a = 0; a < K; ++a) {
+      const std::int32_t n = w.pt_node[i * K + a];
+      if (n < 0) continue;
+      const double N = w.pt_N[i * K + a];
+      dx += N * w.du[n];
+      dv += N * (w.v[n] - w.v_p2g[n]);
+      vpic += N * w.v[n];
+    }
+    // G2P: x_p += sum N du; v_p = flip (v_p + sum N dv) + (1 - flip) sum N v (method.md §2).
+    points_.x[p] += dx;
+    points_.v[p] = alpha * (points_.v[p] + dv) + (1.0 - alpha) * vpic;
+    points_.F[p] = F_trial_[p];
+    points_.sigma[p] = sigma_trial_[p];
+    if constexpr (Dim == 2) points_.sigma_zz[p] = sigma_zz_trial_[p];
+    points_.volume[p] = J_trial_[p] * points_.volume0[p];
+  }
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::commit() {
+  if (!step_ready_) throw std::logic_error("ImplicitSolver::commit without a converged step");
+  ScopedStage t(&timers_, "g2p");
+  const std::size_t ng = grains_.size();
+  const bool linear = settings_.shape == grid::ShapeKind::kLinear;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t g = 0; g < ng; ++g) {
+    if (linear)
+      commit_grain<grid::Linear1D>(g);
+    else
+      commit_grain<grid::UGimp1D>(g);
+  }
+  points_.history.swap(history_trial_);
+  step_ready_ = false;
+}
+
+template <int Dim>
+double ImplicitSolver<Dim>::field_mass(std::size_t g) const {
+  double m = 0;
+  for (double x : work_.at(g)->m) m += x;
+  return m;
+}
+
+template <int Dim>
+Vec<Dim> ImplicitSolver<Dim>::field_momentum(std::size_t g) const {
+  Vec<Dim> p = Vec<Dim>::Zero();
+  const GrainWork& w = *work_.at(g);
+  for (std::size_t a = 0; a < w.m.size(); ++a) p += w.m[a] * w.v[a];
+  return p;
+}
+
+template class ImplicitSolver<2>;
+template class ImplicitSolver<3>;
+
+}  // namespace mpmcd::mpm
