@@ -49,8 +49,9 @@ struct InitialVelocity {
 
 /// [[grains]]: one grain (a body made of material points).
 struct GrainSection {
-  std::string shape;               ///< "disk" or "rectangle"
-  std::string material;            ///< material name [-]
+  std::string shape;     ///< "disk", "rectangle" or "packing"
+  std::string material;  ///< material name [-]
+  std::string file;      ///< packing file (shape "packing"), resolved against the input's folder
   std::vector<double> center;      ///< disk center [m] (disk)
   double radius = 0.0;             ///< disk radius [m] (disk)
   std::vector<double> min_corner;  ///< lower corner [m] (rectangle)
