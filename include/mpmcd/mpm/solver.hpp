@@ -32,7 +32,7 @@ struct Settings {
   double theta = 1.0;                                ///< theta in [1/2, 1] (method.md §2) [-]
   int max_iterations = 25;             ///< Newton iterations before the step fails [-]
   double residual_tolerance = 1e-10;   ///< |R| <= tol * (|M v^n| + dt |f|) [-]
-  double increment_tolerance = 1e-10;  ///< |dv|_inf <= tol * |v|_inf [-]
+  double increment_tolerance = 1e-10;  ///< |dv|_M <= tol * |v|_M (mass norms) [-]
   LinearSolverKind linear_solver = LinearSolverKind::kLdlt;  ///< per-grain linear solver
   double cg_tolerance = 1e-12;                               ///< relative CG residual [-]
   int cg_max_iterations = 1000;                              ///< CG iteration cap [-]
