@@ -3,19 +3,85 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <iostream>
+
+#include "mpmcd/app/simulation.hpp"
 #include "mpmcd/core/errors.hpp"
+#include "mpmcd/core/log.hpp"
+#include "mpmcd/io/load_config.hpp"
+#include "mpmcd/materials/law.hpp"
 #include "mpmcd/version.hpp"
 
 namespace mpmcd::app {
 
+namespace {
+
+void print_laws() {
+  for (const auto& law : materials::law_registry()) {
+    std::cout << law.name << ": " << law.description << "\n";
+    for (const auto& p : law.params)
+      std::cout << "    " << p.name << " [" << p.unit << "]: " << p.description << "\n";
+  }
+}
+
+}  // namespace
+
 int run_cli(int argc, char** argv) {
   CLI::App cli{"mpmcd: implicit MPM with Contact Dynamics for soft granular matter"};
   cli.set_version_flag("--version", fmt::format("mpmcd {} ({})", kVersion, kGitHash));
+  cli.require_subcommand(1);
+
+  RunOptions run_opt;
+  std::string run_input;
+  auto* run = cli.add_subcommand("run", "run a simulation from a TOML input");
+  run->add_option("input", run_input, "input file (TOML, see docs/input.md)")->required();
+  run->add_flag("-q,--quiet", run_opt.quiet, "no progress or info lines");
+  run->add_option("-o,--output", run_opt.output_dir, "output folder (overrides [output] folder)");
+  run->add_option("-t,--threads", run_opt.threads, "OpenMP threads (overrides [simulation])")
+      ->check(CLI::Range(1, 1024));
+
+  std::string check_input;
+  auto* check = cli.add_subcommand("check", "validate an input file and exit");
+  check->add_option("input", check_input, "input file (TOML)")->required();
+
+  std::string list_what;
+  auto* list = cli.add_subcommand("list", "print the input reference or the registered laws");
+  list->add_option("what", list_what, "input | laws")
+      ->required()
+      ->check(CLI::IsMember({"input", "laws"}));
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int rc = cli.exit(e);
     return rc == 0 ? 0 : static_cast<int>(ExitCode::kInput);
+  }
+
+  try {
+    if (*run) {
+      setup_logging(run_opt.quiet ? Verbosity::kQuiet : Verbosity::kNormal);
+      const io::Config cfg = io::load_config(run_input);
+      run_simulation(cfg, run_opt);
+    } else if (*check) {
+      const io::Config cfg = io::load_config(check_input);
+      const auto model = build_model(cfg);
+      std::cout << fmt::format("{}: valid ({} grains, {} material points)\n", check_input,
+                               model.grains.size(), model.points.size());
+    } else if (*list) {
+      if (list_what == "input")
+        std::cout << io::input_reference_markdown();
+      else
+        print_laws();
+    }
+  } catch (const InputError& e) {
+    std::cerr << "mpmcd: input error: " << e.what() << "\n";
+    return static_cast<int>(ExitCode::kInput);
+  } catch (const NumericalError& e) {
+    std::cerr << "mpmcd: the simulation cannot go on: " << e.what() << "\n";
+    return static_cast<int>(ExitCode::kNumerical);
+  } catch (const std::exception& e) {
+    std::cerr << "mpmcd: error: " << e.what() << "\n";
+    return static_cast<int>(ExitCode::kRuntime);
   }
   return 0;
 }

@@ -207,7 +207,12 @@ Schema build_schema() {
             .nonempty()
             .distinct(),
         KeySpec::numbers("velocity", "Dim", "m/s", "prescribed velocity (free components ignored)")
-            .defaults("zeros")},
+            .defaults("zeros"),
+        KeySpec::boolean("moving",
+                         "the box translates with `velocity` (a grid platen): at time t the set "
+                         "is the nodes inside [box_min + velocity t, box_max + velocity t]")
+            .defaults("false")
+            .with_note("box")},
        ""});
 
   s.tables.push_back({"loads",
@@ -536,6 +541,7 @@ class ConfigReader {
       r.read("box_max", b.box_max);
       r.read("fix", b.fix);
       r.read("velocity", b.velocity);
+      r.read("moving", b.moving);
       if (b.velocity.empty()) b.velocity.assign(dim_, 0.0);
       if (dim_ < 3 && (b.nodes == "zmin" || b.nodes == "zmax"))
         r.fail("nodes", fmt::format("\"{}\" exists only in 3D (dimension = 3)", b.nodes));
@@ -559,7 +565,7 @@ class ConfigReader {
                                      vec_text(b.box_min), vec_text(b.box_max), kAxes[a]));
         }
       } else {
-        for (const char* k : {"box_min", "box_max"})
+        for (const char* k : {"box_min", "box_max", "moving"})
           if (r.has(k)) r.fail(k, "key is only for nodes = \"box\"");
       }
       c.boundaries.push_back(std::move(b));

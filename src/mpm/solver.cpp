@@ -60,6 +60,7 @@ struct ImplicitSolver<Dim>::GrainWork {
   double res_norm = 0, res_ref = 0, dv_norm = 0;
   std::vector<double> history;  // |R| / reference per iteration
   std::string failure;
+  bool retryable = true;  // a smaller dt may cure the failure
   std::int64_t fail_point = -1;
 };
 
@@ -78,9 +79,13 @@ ImplicitSolver<Dim>::~ImplicitSolver() = default;
 
 template <int Dim>
 void ImplicitSolver<Dim>::set_boundary_conditions(const std::vector<VelocityBC<Dim>>& bcs) {
+  // Clear only the nodes set before (moving node sets are replaced every step).
+  for (const auto& old : bcs_)
+    for (std::int64_t n : old.nodes) {
+      bc_mask_[n] = 0;
+      for (int d = 0; d < Dim; ++d) bc_set_[d][n] = -1;
+    }
   bcs_ = bcs;
-  std::fill(bc_mask_.begin(), bc_mask_.end(), 0);
-  for (int d = 0; d < Dim; ++d) std::fill(bc_set_[d].begin(), bc_set_[d].end(), -1);
   for (std::size_t s = 0; s < bcs_.size(); ++s)
     for (std::int64_t n : bcs_[s].nodes) {
       bc_mask_[n] |= bcs_[s].mask;
@@ -111,6 +116,7 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   w.iterations = 0;
   w.solves = 0;
   w.failure.clear();
+  w.retryable = true;
   w.fail_point = -1;
   w.history.clear();
   w.pt_first.resize(np);
@@ -134,7 +140,9 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
     if ((ps.first.array() < 0).any() ||
         ((ps.first.array() + S1::kNodes - 1) >= grid_.nodes_per_axis().array()).any() ||
         !points_.x[p].allFinite()) {
-      w.failure = "material point left the grid";
+      w.failure =
+          "material point left the grid (or came within the shape-function support of its edge)";
+      w.retryable = false;
       w.fail_point = p;
       return;
     }
@@ -501,13 +509,14 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         stats.failure = work_[g]->failure;
         stats.grain = static_cast<std::int64_t>(g);
         stats.point = work_[g]->fail_point;
+        stats.retryable = work_[g]->retryable;
         return true;
       }
     return false;
   };
   {
     ScopedStage t(&timers_, "p2g");
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
     for (std::size_t g = 0; g < ng; ++g) {
       if (linear)
         setup_grain<grid::Linear1D>(g, dt);
@@ -519,7 +528,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   for (int it = 0; it <= settings_.max_iterations; ++it) {
     {
       ScopedStage t(&timers_, "newton.assemble");
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
       for (std::size_t g = 0; g < ng; ++g) {
         GrainWork& w = *work_[g];
         if (w.converged || !w.failure.empty()) continue;
@@ -546,7 +555,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     if (it == settings_.max_iterations) break;
     {
       ScopedStage t(&timers_, "newton.solve");
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
       for (std::size_t g = 0; g < ng; ++g) {
         GrainWork& w = *work_[g];
         if (!w.converged && w.failure.empty()) solve_grain(g, dt);
@@ -608,7 +617,7 @@ void ImplicitSolver<Dim>::commit() {
   ScopedStage t(&timers_, "g2p");
   const std::size_t ng = grains_.size();
   const bool linear = settings_.shape == grid::ShapeKind::kLinear;
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
   for (std::size_t g = 0; g < ng; ++g) {
     if (linear)
       commit_grain<grid::Linear1D>(g);

@@ -68,6 +68,7 @@ struct BoundarySection {
   std::vector<double> box_max;   ///< upper corner of the node box [m] (nodes = "box")
   std::vector<std::string> fix;  ///< prescribed components: subset of "x","y","z"
   std::vector<double> velocity;  ///< prescribed velocity [m/s], Dim entries (free ones ignored)
+  bool moving = false;           ///< box translates with `velocity` (grid platen) [-]
   std::int64_t line = 0;         ///< line of the table in the input
 };
 

@@ -59,8 +59,9 @@ struct StepStats {
   std::int64_t linear_solves = 0;        ///< linear solves, summed over grains
   std::vector<double> residual_history;  ///< per iteration: max over grains of |R| / reference
   std::string failure;                   ///< why the step failed ("" if converged)
-  std::int64_t grain = -1;               ///< grain involved in the failure, -1 if none
-  std::int64_t point = -1;               ///< point involved in the failure, -1 if none
+  bool retryable = true;    ///< false if a smaller dt cannot help (a point left the grid)
+  std::int64_t grain = -1;  ///< grain involved in the failure, -1 if none
+  std::int64_t point = -1;  ///< point involved in the failure, -1 if none
 };
 
 /// Implicit MPM stepper for independent grains (contact couples them in a later stage).

@@ -1,0 +1,48 @@
+#pragma once
+/// The simulation driver: builds the model from the validated input, runs the implicit steps with
+/// time-step cuts on failure, and writes the outputs (VTU/PVD series, CSV time series, input copy).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mpmcd/io/config.hpp"
+#include "mpmcd/mpm/model.hpp"
+#include "mpmcd/mpm/solver.hpp"
+
+namespace mpmcd::app {
+
+/// Command-line options of `mpmcd run`.
+struct RunOptions {
+  bool quiet = false;      ///< no progress lines or info messages
+  std::string output_dir;  ///< overrides [output] folder if not empty
+  int threads = 0;         ///< overrides [simulation] threads if > 0
+};
+
+/// Summary of a finished run.
+struct RunSummary {
+  std::int64_t steps = 0;              ///< committed steps
+  std::int64_t failed_steps = 0;       ///< attempts retried with a smaller dt
+  std::int64_t newton_iterations = 0;  ///< sum over steps
+  double time = 0;                     ///< final simulated time [s]
+  double wall_seconds = 0;             ///< wall time of the stepping loop [s]
+  std::string output_dir;              ///< where the outputs are
+};
+
+/// Builds the 2D model (grid, materials, seeded grains, initial velocities) from the input;
+/// throws InputError for inputs that pass the schema but cannot be built (e.g. a grain too small
+/// to hold one material point).
+mpm::Model<2> build_model(const io::Config& config);
+
+/// Node sets and prescribed velocities of the [[boundary]] tables at time t [s] (moving boxes are
+/// translated by velocity * t).
+std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& config,
+                                                 const grid::Grid<2>& grid, double t);
+
+/// Solver settings from the input.
+mpm::Settings<2> build_settings(const io::Config& config);
+
+/// Runs the whole simulation; throws InputError (exit 2) or NumericalError (exit 3, after writing
+/// the last good state).
+RunSummary run_simulation(const io::Config& config, const RunOptions& options);
+
+}  // namespace mpmcd::app
