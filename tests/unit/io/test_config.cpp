@@ -14,7 +14,7 @@ using mpmcd::io::parse_config;
 namespace {
 
 const std::string kExample =
-    std::string(MPMCD_SOURCE_DIR) + "/examples/squeezed_disk/squeezed_disk.toml";
+    std::string(MPMCD_TEST_DIR) + "/full_input.toml";  // a frozen copy: examples evolve
 
 /// A small valid input (lines 1..22); tests append tables to it.
 const std::string kMinimal = R"(# minimal input

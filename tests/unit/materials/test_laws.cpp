@@ -16,7 +16,7 @@ template <int Dim>
 Mat<Dim> stress(const materials::Law<Dim>& law, const Mat<Dim>& F, double* energy = nullptr) {
   Mat<Dim> sigma;
   double w = 0;
-  LawBatch<Dim> b{{&F, 1}, {}, {}, {&sigma, 1}, {}, {&w, 1}};
+  LawBatch<Dim> b{{&F, 1}, {}, {}, {&sigma, 1}, {}, {&w, 1}, {}};
   law.evaluate(b);
   if (energy) *energy = w;
   return sigma;
@@ -64,7 +64,7 @@ void check_tangent(const std::string& name) {
     if (F.determinant() < 0.3) continue;
     Mat<Dim> sigma;
     Tensor4<Dim> a;
-    LawBatch<Dim> b{{&F, 1}, {}, {}, {&sigma, 1}, {&a, 1}, {}};
+    LawBatch<Dim> b{{&F, 1}, {}, {}, {&sigma, 1}, {&a, 1}, {}, {}};
     law->evaluate(b);
     const Tensor4<Dim> a_fd = fd_tangent(*law, F, 1e-6);
     const double err = (a - a_fd).norm() / a_fd.norm();
