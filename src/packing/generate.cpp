@@ -259,37 +259,53 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
     // per disk exceeds kUnjammedEnergy. Bisection between the densest unjammed and the loosest
     // jammed state until their gap < jam_phi_tolerance.
     std::vector<double> lo_x, lo_y, hi_x, hi_y;
-    double phi_lo = -1.0, phi_hi = -1.0, phi = phi_ref;
-    const double step = 0.005;
+    double phi_lo = -1.0, phi_hi = -1.0, phi = phi_ref, step = 0.005;
     bool jammed = dem.energy() / static_cast<double>(n) > kUnjammedEnergy;
+    bool from_lo = false;     // the last trial started from the densest unjammed state
+    bool hi_from_lo = false;  // the loosest jammed state was compressed from that state
     for (int iter = 0; iter < 400; ++iter) {
       if (jammed) {
         phi_hi = phi;
         dem.get_positions(hi_x, hi_y);
+        hi_from_lo = from_lo;
       } else {
         phi_lo = phi;
         dem.get_positions(lo_x, lo_y);
+        hi_from_lo = false;
       }
-      if (phi_lo > 0.0 && phi_hi > 0.0 && phi_hi - phi_lo < p.jam_phi_tolerance) break;
+      if (phi_lo > 0.0 && phi_hi > 0.0 && phi_hi - phi_lo < p.jam_phi_tolerance) {
+        if (hi_from_lo) break;
+        // Otherwise the jammed state came from an older, coarser path: compress the densest
+        // unjammed state to phi_hi (below); if that is unjammed, go on from it in half-tolerance
+        // steps.
+      }
       if (phi_hi < 0.0)
-        phi = std::min(phi + step, 0.91);
+        phi = std::min(phi_lo > 0.0 ? phi_lo + step : phi + step, 0.91);
       else if (phi_lo < 0.0)
         phi = std::max(phi - step, 0.05);
-      else
+      else if (phi_hi - phi_lo >= p.jam_phi_tolerance)
         phi = 0.5 * (phi_lo + phi_hi);
-      if (phi_lo > 0.0)
+      else
+        phi = phi_hi;
+      from_lo = phi_lo > 0.0;
+      if (from_lo)
         dem.set_positions(lo_x, lo_y);
       else
         dem.set_positions(hi_x, hi_y);
       dem.set_scale(std::sqrt(phi / phi_ref));
       const auto res = dem.minimize(p.max_relax_steps, 0.0, kUnjammedEnergy, kForceStop);
       jammed = res.energy_per_disk > kUnjammedEnergy;
+      if (!jammed && phi >= phi_hi && phi_hi > 0.0) {
+        // phi_hi was jammed along another path but not from here: search above again.
+        phi_hi = -1.0;
+        step = 0.5 * p.jam_phi_tolerance;
+      }
       log().debug("packing: jam search phi = {:.6f}: {} (E/N = {:.3g}, |F| = {:.3g}, {} steps)",
                   phi, jammed ? "jammed" : "unjammed", res.energy_per_disk, res.max_force,
                   res.steps);
       if (phi >= 0.91 || phi <= 0.05) break;
     }
-    report.relaxed = phi_lo > 0.0 && phi_hi > 0.0;
+    report.relaxed = phi_lo > 0.0 && phi_hi > 0.0 && hi_from_lo;
     if (phi_hi > 0.0) {
       dem.set_positions(hi_x, hi_y);
       dem.set_scale(std::sqrt(phi_hi / phi_ref));
