@@ -1,0 +1,147 @@
+// The `mpmcd` command line as a user runs it: exit codes (0 ok, 2 bad input, 3 numerical failure),
+// nothing written for a bad input, the outputs of a run, the last good state after a failure.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string output;
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(MPMCD_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (pipe && fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pipe ? pclose(pipe) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string example() {
+  return std::string(MPMCD_SOURCE_DIR) + "/examples/squeezed_disk/squeezed_disk.toml";
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path scratch(const std::string& name) {
+  fs::path p = fs::temp_directory_path() / ("mpmcd_cli_" + name);
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+// Writes an input whose only grain is given by `grain` and time section by `time`.
+fs::path write_input(const fs::path& dir, const std::string& grain, const std::string& time) {
+  const fs::path p = dir / "case.toml";
+  std::ofstream(p) << "[grid]\norigin = [0.0, 0.0]\nextent = [0.02, 0.02]\ncell_size = 0.001\n"
+                      "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\n"
+                      "lambda = 3e6\nmu = 1.5e6\n"
+                   << grain << time << "[output]\nfolder = \"out\"\n";
+  return p;
+}
+
+}  // namespace
+
+TEST(Cli, CheckAcceptsTheExample) {
+  const Result r = run("check " + example());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("valid (1 grains"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BadInputExitsWith2AndWritesNothing) {
+  const fs::path dir = scratch("bad");
+  const fs::path in = write_input(dir,
+                                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                                  "center = [0.01, 0.01]\nradius = -0.004\n",
+                                  "[time]\ndt = 1e-5\nend_time = 1e-4\n");
+  const Result r = run("run " + in.string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("case.toml:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("radius"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out")) << "output written for a rejected input";
+  EXPECT_EQ(run("run " + (dir / "missing.toml").string()).code, 2);
+  EXPECT_EQ(run("run").code, 2);  // missing argument
+  EXPECT_EQ(run("frobnicate").code, 2);
+}
+
+TEST(Cli, RunWritesSeriesCsvAndStampedInputCopy) {
+  const fs::path dir = scratch("run");
+  const Result r = run("run -q " + example() + " -o " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(r.output.empty()) << "--quiet printed: " << r.output;
+  const std::string copy = read(dir / "input.toml");
+  EXPECT_EQ(copy.rfind("# run by mpmcd ", 0), 0u);
+  EXPECT_NE(copy.find(read(example())), std::string::npos);
+  const std::string pvd = read(dir / "squeezed_disk.pvd");
+  int frames = 0;
+  for (auto& e : fs::directory_iterator(dir)) frames += e.path().extension() == ".vtu";
+  EXPECT_EQ(frames, 25);  // t = 0 and every 2.5e-4 s up to 6e-3 s
+  EXPECT_NE(pvd.find("squeezed_disk_000024.vtu"), std::string::npos);
+  // CSV: header + one row per 5e-5 s; mass identical on every row.
+  std::ifstream csv(dir / "squeezed_disk.csv");
+  std::string line, mass0;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("step,time,dt,newton_iterations", 0), 0u);
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    const std::string mass =
+        line.substr(line.rfind(',', line.rfind(',') - 1) + 1,
+                    line.rfind(',') - line.rfind(',', line.rfind(',') - 1) - 1);
+    if (mass0.empty()) mass0 = mass;
+    EXPECT_EQ(mass, mass0);
+  }
+  EXPECT_EQ(rows, 121);
+}
+
+TEST(Cli, InvertedPointStopsWithExit3AndLastGoodState) {
+  const fs::path dir = scratch("diverge");
+  // A disk crushed along x at 1500 /s with dt = 1 ms: dF11 = -0.5 -> J < 0; no dt cut allowed.
+  const fs::path in = write_input(dir,
+                                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                                  "center = [0.01, 0.01]\nradius = 0.004\n"
+                                  "[grains.initial]\ngradient = [-1500.0, 0.0, 0.0, 0.0]\n",
+                                  "[time]\ndt = 1e-3\ndt_min = 1e-3\nend_time = 1e-2\n");
+  const Result r = run("run " + in.string());
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("J = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("step 1"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("grain 0"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_last_good.vtu")) << r.output;
+}
+
+TEST(Cli, PointLeavingTheGridStopsWithExit3) {
+  const fs::path dir = scratch("leave");
+  const fs::path in = write_input(dir,
+                                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                                  "center = [0.01, 0.01]\nradius = 0.004\n"
+                                  "[grains.initial]\nvelocity = [10.0, 0.0]\n",
+                                  "[time]\ndt = 1e-4\nend_time = 1e-2\n");
+  const Result r = run("run " + in.string());
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("left the grid"), std::string::npos) << r.output;
+}
+
+TEST(Cli, ListPrintsInputReferenceAndLaws) {
+  const Result a = run("list input");
+  EXPECT_EQ(a.code, 0);
+  EXPECT_EQ(a.output, read(fs::path(MPMCD_SOURCE_DIR) / "docs" / "input.md"));
+  const Result b = run("list laws");
+  EXPECT_EQ(b.code, 0);
+  EXPECT_NE(b.output.find("neo_hookean"), std::string::npos);
+}
