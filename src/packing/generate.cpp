@@ -105,16 +105,16 @@ namespace {
 
 using detail::Dem;
 
-// Uniform double in [0, 1) from the 53 high bits of one mt19937_64 draw (portable, unlike
-// std::uniform_real_distribution).
+// Uniform double in [0, 1) (docs/packing.md eq. 0) from the 53 high bits of one mt19937_64 draw
+// (portable, unlike std::uniform_real_distribution).
 double uniform01(std::mt19937_64& rng) {
   return static_cast<double>(rng() >> 11) * 0x1.0p-53;
 }
 
 // Energy per disk below which a minimised state counts as unjammed [k_n d^2]. O'Hern et al.
 // (Phys. Rev. E 68 (2003) 011306, §II) use 1e-16; since E/N ~ 0.2 (phi - phi_J)^2 above jamming
-// (measured, §7), 1e-14 shifts phi_J by < 1e-6, far below jam_phi_tolerance, and is reached
-// much sooner by states just below jamming.
+// (measured, docs/packing.md §3), 1e-14 shifts phi_J by < 1e-6, far below jam_phi_tolerance, and is
+// reached much sooner by states just below jamming.
 constexpr double kUnjammedEnergy = 1e-14;
 // A minimum is found when the largest net force < this * sqrt(2 E/N), the typical contact force.
 constexpr double kForceStop = 1e-6;
