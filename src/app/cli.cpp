@@ -10,6 +10,7 @@
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/load_config.hpp"
 #include "mpmcd/materials/law.hpp"
+#include "mpmcd/packing/pack_command.hpp"
 #include "mpmcd/version.hpp"
 
 namespace mpmcd::app {
@@ -50,6 +51,12 @@ int run_cli(int argc, char** argv) {
       ->required()
       ->check(CLI::IsMember({"input", "laws"}));
 
+  std::string pack_input;
+  bool pack_quiet = false;
+  auto* pack = cli.add_subcommand("pack", "generate a disk packing by DEM (docs/packing.md)");
+  pack->add_option("input", pack_input, "packing input (TOML)")->required();
+  pack->add_flag("-q,--quiet", pack_quiet, "only the summary line");
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -67,6 +74,9 @@ int run_cli(int argc, char** argv) {
       const auto model = build_model(cfg);
       std::cout << fmt::format("{}: valid ({} grains, {} material points)\n", check_input,
                                model.grains.size(), model.points.size());
+    } else if (*pack) {
+      setup_logging(pack_quiet ? Verbosity::kQuiet : Verbosity::kNormal);
+      return packing::pack_command(pack_input, pack_quiet);
     } else if (*list) {
       if (list_what == "input")
         std::cout << io::input_reference_markdown();

@@ -12,6 +12,8 @@
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/vtu.hpp"
+#include "mpmcd/packing/packing.hpp"
+#include "mpmcd/packing/seeding.hpp"
 #include "mpmcd/points/seeding.hpp"
 #include "mpmcd/version.hpp"
 
@@ -37,6 +39,34 @@ Vec<2> initial_velocity(const io::InitialVelocity& iv, const Vec<2>& c, const Ve
   if (iv.sine_amplitude.size() == 2 && iv.sine_wavevector.size() == 2)
     v += vec2(iv.sine_amplitude) * std::sin(vec2(iv.sine_wavevector).dot(x) + iv.sine_phase);
   return v;
+}
+
+// Every disk of a packing file becomes a grain (points from packing::seed_packing, which gives a
+// lattice site shared by two overlapping disks to one of them only).
+void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t index,
+                        int material) {
+  const auto& g = cfg.grains[index];
+  const packing::Packing pk = packing::read_packing_csv(g.file);
+  const double h = model.grid.cell_size();
+  const Vec<2> lo = model.grid.origin().array() + h, hi = model.grid.upper().array() - h;
+  for (const auto& d : pk.disks) {
+    const Vec<2> c(d.x, d.y);
+    if (((c.array() - d.radius) < lo.array()).any() || ((c.array() + d.radius) > hi.array()).any())
+      throw InputError(g.file, 0, fmt::format("disk {}", d.id),
+                       fmt::format("the disk (center {:.6g} {:.6g} m, radius {:.6g} m) must lie "
+                                   "inside the grid with one cell of margin (grains[{}], {}:{})",
+                                   d.x, d.y, d.radius, index, cfg.source_path, g.line));
+  }
+  const auto seeded = packing::seed_packing(pk, model.grid.origin(), h, g.points_per_cell);
+  for (std::size_t k = 0; k < pk.disks.size(); ++k) {
+    points::Seeds<2> seeds;
+    seeds.x.assign(seeded.x.begin() + seeded.offset[k], seeded.x.begin() + seeded.offset[k + 1]);
+    seeds.volume.assign(seeded.volume.begin() + seeded.offset[k],
+                        seeded.volume.begin() + seeded.offset[k + 1]);
+    const Vec<2> c(pk.disks[k].x, pk.disks[k].y);
+    model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
+                    [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
+  }
 }
 
 }  // namespace
@@ -69,9 +99,12 @@ mpm::Model<2> build_model(const io::Config& cfg) {
       const Vec<2> lo = vec2(g.min_corner), hi = vec2(g.max_corner);
       center = 0.5 * (lo + hi);
       seeds = points::seed_box<2>(model.grid.origin(), h, g.points_per_cell, lo, hi);
+    } else if (g.shape == "packing") {
+      add_packing_grains(model, cfg, i, material);
+      continue;
     } else {
       throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].shape", i),
-                       "shape \"" + g.shape + "\" is not supported by `mpmcd run` yet");
+                       "unknown shape \"" + g.shape + "\"");
     }
     if (seeds.x.empty())
       throw InputError(cfg.source_path, g.line, fmt::format("grains[{}]", i),

@@ -27,9 +27,12 @@ using SpMat = Eigen::SparseMatrix<double>;
 /// the shape functions of its points at x^n, the block-stencil tangent and its sparse solver.
 template <int Dim>
 struct ImplicitSolver<Dim>::GrainWork {
-  IVec<Dim> box_lo, box_n;                  // node box [lo, lo + n)
-  std::vector<std::int32_t> box_to_active;  // box node -> active node (-1: no mass)
-  std::vector<double> box_m;                // scratch P2G accumulators on the box
+  IVec<Dim> box_lo, box_n;                       // node box [lo, lo + n)
+  std::vector<std::int32_t> box_to_active;       // box node -> active node (-1: no mass)
+  std::vector<std::int32_t> prev_box_to_active;  // previous step's, for pattern reuse
+  IVec<Dim> prev_box_lo = IVec<Dim>::Zero(), prev_box_n = IVec<Dim>::Zero();
+  bool pattern_valid = false;  // stencil / sparse pattern / symbolic analysis are built
+  std::vector<double> box_m;   // scratch P2G accumulators on the box
   std::vector<Vec<Dim>> box_mv, box_f, box_fext;
   std::vector<std::int64_t> node_global;  // active node -> global node index
   std::vector<IVec<Dim>> node_box;        // active node -> box coordinates
@@ -178,6 +181,11 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
       w.box_fext[b] += N * mg;
     }
   }
+  // Keep the previous step's active set to reuse the sparse pattern when it has not changed.
+  w.prev_box_to_active.swap(w.box_to_active);
+  const bool same_box = w.pattern_valid && w.prev_box_lo == lo && w.prev_box_n == w.box_n;
+  w.prev_box_lo = lo;
+  w.prev_box_n = w.box_n;
   reset(w.box_to_active, nb, std::int32_t{-1});
   w.node_global.clear();
   w.node_box.clear();
@@ -233,6 +241,10 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   reset(w.R, na, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.du, na, Vec<Dim>(Vec<Dim>::Zero()));
   (void)dt;
+  // The pattern (stencil, sparse structure, symbolic factorisation) depends only on the active
+  // node set: reuse it when unchanged (the usual case at small dt).
+  if (same_box && w.box_to_active == w.prev_box_to_active) return;
+  w.pattern_valid = true;
   // Stencil of the tangent: node b couples to node a if |c_b - c_a| <= radius per axis.
   w.radius = S1::kNodes - 1;
   const int width = 2 * w.radius + 1;

@@ -2,6 +2,7 @@
 /// VTK XML writers: point clouds as UnstructuredGrid (.vtu, raw appended binary), .pvd time series.
 /// Files are written to "<path>.tmp" and renamed, so a crash never leaves a half-written file.
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@ class VtuPointCloud {
     positions_[3 * i + 2] = z;
   }
   /// Adds a point-data array of `components` doubles per point (1 scalar, 3 vector, 9 tensor).
-  /// Returns the array storage (size n * components) to be filled by the caller.
+  /// Returns the array storage (size n * components), valid for the cloud's lifetime.
   std::vector<double>& add_array(const std::string& name, int components);
   /// Adds a point-data array of 32-bit integers (1 component).
   std::vector<std::int32_t>& add_int_array(const std::string& name);
@@ -40,8 +41,8 @@ class VtuPointCloud {
   };
   std::size_t n_;
   std::vector<double> positions_;
-  std::vector<Array> arrays_;
-  std::vector<IntArray> int_arrays_;
+  std::deque<Array> arrays_;  // deque: references returned by add_array stay valid
+  std::deque<IntArray> int_arrays_;
 };
 
 /// A ParaView .pvd collection listing one file per time [s]; rewritten atomically on each add.

@@ -145,3 +145,35 @@ TEST(Cli, ListPrintsInputReferenceAndLaws) {
   EXPECT_EQ(b.code, 0);
   EXPECT_NE(b.output.find("neo_hookean"), std::string::npos);
 }
+
+TEST(Cli, PackThenRunGrainsFromThePackingFile) {
+  const fs::path dir = scratch("pack");
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ncount = 12\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "aspect_ratio = 1.0\norigin = [0.0, 0.0]\ntarget_phi = 0.7\nmethod = \"grow\"\n"
+         "seed = 7\n[output]\nfolder = \""
+      << dir.string() << "\"\nname = \"packing\"\n";
+  const Result p = run("pack -q " + (dir / "pack.toml").string());
+  ASSERT_EQ(p.code, 0) << p.output;
+  EXPECT_NE(p.output.find("packing: 12 grains, phi = 0.700000"), std::string::npos) << p.output;
+  std::ofstream(dir / "run.toml")
+      << "[grid]\norigin = [-0.001, -0.001]\nextent = [0.006, 0.006]\ncell_size = 0.000125\n"
+         "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\n"
+         "lambda = 3e6\nmu = 1.5e6\n[[grains]]\nshape = \"packing\"\nfile = \"packing.csv\"\n"
+         "material = \"gel\"\n[time]\ndt = 1e-7\nend_time = 5e-7\n[output]\nfolder = \"out\"\n";
+  const Result c = run("check " + (dir / "run.toml").string());
+  EXPECT_EQ(c.code, 0) << c.output;
+  EXPECT_NE(c.output.find("valid (12 grains"), std::string::npos) << c.output;
+  const Result r = run("run -q " + (dir / "run.toml").string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd.csv"));
+  // A packing whose disk leaves the grid is refused with the disk named.
+  std::ofstream(dir / "small.toml")
+      << "[grid]\norigin = [0.0, 0.0]\nextent = [0.002, 0.002]\ncell_size = 0.000125\n"
+         "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\n"
+         "lambda = 3e6\nmu = 1.5e6\n[[grains]]\nshape = \"packing\"\nfile = \"packing.csv\"\n"
+         "material = \"gel\"\n[time]\ndt = 1e-7\nend_time = 5e-7\n";
+  const Result s = run("run " + (dir / "small.toml").string());
+  EXPECT_EQ(s.code, 2) << s.output;
+  EXPECT_NE(s.output.find("packing.csv: key 'disk "), std::string::npos) << s.output;
+}
