@@ -9,6 +9,17 @@
 
 namespace mpmcd::materials {
 
+/// Fills a_ijkl = c(i, j, k, l) + delta_ik sigma_jl: the material tangent `c` [Pa] plus the
+/// geometric term (law.hpp convention).
+template <int Dim, class C>
+void fill_spatial_tangent(Tensor4<Dim>& a, const Mat<Dim>& sigma, C&& c) {
+  for (int i = 0; i < Dim; ++i)
+    for (int j = 0; j < Dim; ++j)
+      for (int k = 0; k < Dim; ++k)
+        for (int l = 0; l < Dim; ++l)
+          a(i * Dim + j, k * Dim + l) = c(i, j, k, l) + kron(i, k) * sigma(j, l);
+}
+
 /// Compressible Neo-Hookean (paper eq. 8): S = (lambda ln J - mu) C^-1 + mu I, i.e. Kirchhoff
 /// stress tau = mu (b - I) + lambda ln J I and c = (lambda/J) I x I + (2/J)(mu - lambda ln J) I^sym
 /// (method.md §3); energy W = mu/2 (tr C - 3) - mu ln J + lambda/2 (ln J)^2.
@@ -39,15 +50,10 @@ class NeoHookean final : public Law<Dim> {
       if (want_tangent) {
         const double a1 = lambda_ / J;                // coefficient of delta_ij delta_kl
         const double a2 = (mu_ - lambda_ * lnJ) / J;  // coefficient of (d_ik d_jl + d_il d_jk)
-        Tensor4<Dim>& a = batch.tangent[p];
-        for (int i = 0; i < Dim; ++i)
-          for (int j = 0; j < Dim; ++j)
-            for (int k = 0; k < Dim; ++k)
-              for (int l = 0; l < Dim; ++l)
-                a(i * Dim + j, k * Dim + l) =
-                    a1 * kron(i, j) * kron(k, l) +
-                    a2 * (kron(i, k) * kron(j, l) + kron(i, l) * kron(j, k)) +
-                    kron(i, k) * sigma(j, l);
+        fill_spatial_tangent<Dim>(batch.tangent[p], sigma, [&](int i, int j, int k, int l) {
+          return a1 * kron(i, j) * kron(k, l) +
+                 a2 * (kron(i, k) * kron(j, l) + kron(i, l) * kron(j, k));
+        });
       }
     }
   }
@@ -80,15 +86,9 @@ class SaintVenantKirchhoff final : public Law<Dim> {
         batch.energy[p] = 0.5 * lambda_ * E.trace() * E.trace() + mu_ * E.squaredNorm();
       if (!batch.tangent.empty()) {
         const Mat<Dim> b = F * F.transpose();
-        Tensor4<Dim>& a = batch.tangent[p];
-        for (int i = 0; i < Dim; ++i)
-          for (int j = 0; j < Dim; ++j)
-            for (int k = 0; k < Dim; ++k)
-              for (int l = 0; l < Dim; ++l)
-                a(i * Dim + j, k * Dim + l) =
-                    (lambda_ * b(i, j) * b(k, l) + mu_ * (b(i, k) * b(j, l) + b(i, l) * b(j, k))) /
-                        J +
-                    kron(i, k) * sigma(j, l);
+        fill_spatial_tangent<Dim>(batch.tangent[p], sigma, [&](int i, int j, int k, int l) {
+          return (lambda_ * b(i, j) * b(k, l) + mu_ * (b(i, k) * b(j, l) + b(i, l) * b(j, k))) / J;
+        });
       }
     }
   }
@@ -121,14 +121,12 @@ class LinearElastic final : public Law<Dim> {
       if (!batch.energy.empty())
         batch.energy[p] = 0.5 * lambda_ * eps.trace() * eps.trace() + mu_ * eps.squaredNorm();
       if (!batch.tangent.empty()) {
-        Tensor4<Dim>& a = batch.tangent[p];
-        for (int i = 0; i < Dim; ++i)
-          for (int j = 0; j < Dim; ++j)
-            for (int k = 0; k < Dim; ++k)
-              for (int l = 0; l < Dim; ++l)
-                a(i * Dim + j, k * Dim + l) =
-                    sigma(i, j) * kron(k, l) + lambda_ * kron(i, j) * F(l, k) +
-                    mu_ * (kron(i, k) * F(l, j) + kron(j, k) * F(l, i)) - sigma(i, l) * kron(j, k);
+        // c = a - delta_ik sigma_jl with a from the derivative of P = J sigma F^-T
+        fill_spatial_tangent<Dim>(batch.tangent[p], sigma, [&](int i, int j, int k, int l) {
+          return sigma(i, j) * kron(k, l) + lambda_ * kron(i, j) * F(l, k) +
+                 mu_ * (kron(i, k) * F(l, j) + kron(j, k) * F(l, i)) - sigma(i, l) * kron(j, k) -
+                 kron(i, k) * sigma(j, l);
+        });
       }
     }
   }
