@@ -349,13 +349,10 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
       {},
       Dim == 2 ? std::span<double>(sigma_zz_trial_.data() + off, cnt) : std::span<double>()};
   law.evaluate(batch);
-  // Internal force f_I = -sum V sigma grad_{x^{n+1}} N_I with grad_{x^{n+1}} N = dF^-T grad_{x^n}
-  // N, and tangent blocks K_IJ,ik = sum V g_I,j a_ijkl g_J,l (material + geometric, method.md §2).
+  // Internal force f_I = -sum V sigma grad_{x^{n+1}} N_I with grad_{x^{n+1}} N = dF^-T grad_{x^n} N
+  // (seed eq. 5 at n+1, method.md §2).
   std::fill(w.f_int.begin(), w.f_int.end(), Vec<Dim>::Zero());
   std::fill(w.f_abs.begin(), w.f_abs.end(), Vec<Dim>::Zero());
-  std::fill(w.K_blk.begin(), w.K_blk.end(), Mat<Dim>::Zero());
-  Vec<Dim> gx[K];
-  Eigen::Matrix<double, Dim, Dim * Dim> Ma[K];
   for (std::int64_t i = 0; i < np; ++i) {
     const std::int64_t p = gr.begin + i;
     const Mat<Dim>& sig = sigma_trial_[p];
@@ -364,37 +361,13 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
       w.fail_point = p;
       return;
     }
-    const double V = J_trial_[p] * points_.volume0[p];
-    const Tensor4<Dim>& T = tangent_[p];
+    const Mat<Dim> Vsig_dFinvT = J_trial_[p] * points_.volume0[p] * sig * dF_inv_T_[p];
     for (int a = 0; a < K; ++a) {
-      gx[a] = dF_inv_T_[p] * w.pt_dN[i * K + a];
       const std::int32_t n = w.pt_node[i * K + a];
       if (n < 0) continue;
-      const Vec<Dim> fa = V * (sig * gx[a]);
+      const Vec<Dim> fa = Vsig_dFinvT * w.pt_dN[i * K + a];
       w.f_int[n] -= fa;
       w.f_abs[n] += fa.cwiseAbs();
-      // Ma(i, kl) = V sum_j g_j a(ij, kl)
-      for (int ii = 0; ii < Dim; ++ii)
-        for (int kl = 0; kl < Dim * Dim; ++kl) {
-          double acc = 0;
-          for (int j = 0; j < Dim; ++j) acc += gx[a][j] * T(ii * Dim + j, kl);
-          Ma[a](ii, kl) = V * acc;
-        }
-    }
-    for (int a = 0; a < K; ++a) {
-      const std::int32_t na_ = w.pt_node[i * K + a];
-      if (na_ < 0) continue;
-      Mat<Dim>* row = &w.K_blk[static_cast<std::size_t>(na_) * w.S];
-      for (int b = 0; b < K; ++b) {
-        if (w.pt_node[i * K + b] < 0) continue;
-        Mat<Dim>& blk = row[w.pair_slot[a * K + b]];
-        for (int ii = 0; ii < Dim; ++ii)
-          for (int k = 0; k < Dim; ++k) {
-            double acc = 0;
-            for (int l = 0; l < Dim; ++l) acc += Ma[a](ii, k * Dim + l) * gx[b][l];
-            blk(ii, k) += acc;
-          }
-      }
     }
   }
   // Residual R_I = m_I (v^{n+1} - v^n) - dt [(1 - theta) f^n + theta f^{n+1}] (method.md §2).
@@ -432,6 +405,52 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
   const bool inc_ok =
       !w.solved_once || w.dv_norm <= settings_.increment_tolerance * std::sqrt(vref2);
   w.converged = res_ok && inc_ok;
+  if (!w.converged) assemble_tangent<S1>(g);  // only needed when a solve follows
+}
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::assemble_tangent(std::size_t g) {
+  using Shape = grid::PointShape<Dim, S1>;
+  constexpr int K = Shape::K;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  // Tangent blocks K_IJ,ik = sum V g_I,j a_ijkl g_J,l, g = dF^-T grad_{x^n} N (material +
+  // geometric, method.md §2), accumulated into the block stencil through the pair -> slot table.
+  std::fill(w.K_blk.begin(), w.K_blk.end(), Mat<Dim>::Zero());
+  Vec<Dim> gx[K];
+  Eigen::Matrix<double, Dim, Dim * Dim> Ma[K];
+  for (std::int64_t i = 0; i < gr.size(); ++i) {
+    const std::int64_t p = gr.begin + i;
+    const double V = J_trial_[p] * points_.volume0[p];
+    const Tensor4<Dim>& T = tangent_[p];
+    for (int a = 0; a < K; ++a) {
+      gx[a] = dF_inv_T_[p] * w.pt_dN[i * K + a];
+      if (w.pt_node[i * K + a] < 0) continue;
+      // Ma(i, kl) = V sum_j g_j a(ij, kl)
+      for (int ii = 0; ii < Dim; ++ii)
+        for (int kl = 0; kl < Dim * Dim; ++kl) {
+          double acc = 0;
+          for (int j = 0; j < Dim; ++j) acc += gx[a][j] * T(ii * Dim + j, kl);
+          Ma[a](ii, kl) = V * acc;
+        }
+    }
+    for (int a = 0; a < K; ++a) {
+      const std::int32_t na_ = w.pt_node[i * K + a];
+      if (na_ < 0) continue;
+      Mat<Dim>* row = &w.K_blk[static_cast<std::size_t>(na_) * w.S];
+      for (int b = 0; b < K; ++b) {
+        if (w.pt_node[i * K + b] < 0) continue;
+        Mat<Dim>& blk = row[w.pair_slot[a * K + b]];
+        for (int ii = 0; ii < Dim; ++ii)
+          for (int k = 0; k < Dim; ++k) {
+            double acc = 0;
+            for (int l = 0; l < Dim; ++l) acc += Ma[a](ii, k * Dim + l) * gx[b][l];
+            blk(ii, k) += acc;
+          }
+      }
+    }
+  }
 }
 
 template <int Dim>

@@ -100,6 +100,8 @@ class ImplicitSolver {
   void setup_grain(std::size_t g, double dt);
   template <class S1>
   void evaluate_grain(std::size_t g, double dt);
+  template <class S1>
+  void assemble_tangent(std::size_t g);
   void solve_grain(std::size_t g, double dt);
   template <class S1>
   void commit_grain(std::size_t g);
