@@ -12,12 +12,15 @@
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/vtu.hpp"
+#include "mpmcd/packing/input.hpp"
 #include "mpmcd/packing/packing.hpp"
 #include "mpmcd/packing/seeding.hpp"
 #include "mpmcd/points/seeding.hpp"
 #include "mpmcd/version.hpp"
 
 namespace mpmcd::app {
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -46,7 +49,13 @@ Vec<2> initial_velocity(const io::InitialVelocity& iv, const Vec<2>& c, const Ve
 void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t index,
                         int material) {
   const auto& g = cfg.grains[index];
-  const packing::Packing pk = packing::read_packing_csv(g.file);
+  packing::Packing pk;
+  if (fs::path(g.file).extension() == ".toml") {  // a packing input: generate it now (seeded DEM)
+    pk = packing::generate_packing(packing::load_packing_input(g.file).params);
+    log().info("generated from {}: {}", g.file, packing::summary_line(pk));
+  } else {
+    pk = packing::read_packing_csv(g.file);
+  }
   const double h = model.grid.cell_size();
   const Vec<2> lo = model.grid.origin().array() + h, hi = model.grid.upper().array() - h;
   for (const auto& d : pk.disks) {
@@ -162,8 +171,6 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
 }
 
 namespace {
-
-namespace fs = std::filesystem;
 
 // Writes one VTU snapshot of the points.
 void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {

@@ -159,7 +159,9 @@ Schema build_schema() {
         KeySpec::number("radius", "m", "disk radius").greater_than(0.0).with_note("disk"),
         KeySpec::numbers("min_corner", "Dim", "m", "lower corner").with_note("rectangle"),
         KeySpec::numbers("max_corner", "Dim", "m", "upper corner").with_note("rectangle"),
-        KeySpec::string("file", "packing file, relative to the input file's folder")
+        KeySpec::string("file",
+                        "packing CSV file, or a packing input (.toml, docs/packing.md) generated "
+                        "by DEM when the run starts; relative to the input file's folder")
             .nonempty()
             .with_note("packing"),
         KeySpec::integer("points_per_cell", "", "material points per cell along each axis")

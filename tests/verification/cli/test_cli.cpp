@@ -167,6 +167,19 @@ TEST(Cli, PackThenRunGrainsFromThePackingFile) {
   const Result r = run("run -q " + (dir / "run.toml").string());
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd.csv"));
+  // The same packing generated inline from its packing input when the run starts.
+  std::string text;
+  {
+    std::ifstream in(dir / "run.toml");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  text.replace(text.find("packing.csv"), 11, "pack.toml");
+  std::ofstream(dir / "inline.toml") << text;
+  const Result g = run("check " + (dir / "inline.toml").string());
+  EXPECT_EQ(g.code, 0) << g.output;
+  EXPECT_NE(g.output.find("valid (12 grains"), std::string::npos) << g.output;
   // A packing whose disk leaves the grid is refused with the disk named.
   std::ofstream(dir / "small.toml")
       << "[grid]\norigin = [0.0, 0.0]\nextent = [0.002, 0.002]\ncell_size = 0.000125\n"
