@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numbers>
 
 #include "mpmcd/core/errors.hpp"
@@ -167,7 +168,47 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
   s.cg_max_iterations = cfg.solver.cg_max_iterations;
   s.flip = cfg.solver.flip;
   if (cfg.loads.gravity.size() == 2) s.gravity = vec2(cfg.loads.gravity);
+  // Contact: enabled when asked and there is something to touch (two grains or a wall).
+  auto& c = s.contact;
+  std::size_t grains = 0;
+  for (const auto& g : cfg.grains) grains += g.shape == "packing" ? 2 : 1;
+  c.enabled = cfg.contact.enabled && (grains > 1 || !cfg.walls.empty());
+  c.criterion =
+      cfg.contact.criterion == "overlap" ? mpm::GapCriterion::kOverlap : mpm::GapCriterion::kGap;
+  c.mass_fraction = cfg.contact.mass_fraction;
+  c.gs.tolerance = cfg.contact.tolerance;
+  c.gs.max_sweeps = cfg.contact.max_sweeps;
+  c.impulse_tolerance = cfg.contact.impulse_tolerance;
+  c.wall_range = cfg.contact.wall_range;
+  const auto nm = static_cast<int>(cfg.materials.size());
+  c.materials = nm;
+  c.friction.assign(static_cast<std::size_t>(nm * nm), cfg.contact.friction);
+  auto index = [&](const std::string& name) {
+    for (int k = 0; k < nm; ++k)
+      if (cfg.materials[k].name == name) return k;
+    return 0;
+  };
+  for (const auto& p : cfg.contact.pairs) {
+    const int a = index(p.materials[0]), b = index(p.materials[1]);
+    c.friction[a * nm + b] = c.friction[b * nm + a] = p.friction;
+  }
+  for (const auto& w : cfg.walls)
+    c.walls.push_back({w.name, vec2(w.point), vec2(w.normal), vec2(w.velocity), w.friction});
   return s;
+}
+
+void check_walls_enclose(const io::Config& cfg, const mpm::Model<2>& model,
+                         const mpm::Settings<2>& settings) {
+  for (std::size_t k = 0; k < settings.contact.walls.size(); ++k) {
+    const auto& wall = settings.contact.walls[k];
+    for (std::size_t p = 0; p < model.points.size(); ++p)
+      if (wall.distance(model.points.x[p], 0.0) < 0.0)
+        throw InputError(cfg.source_path, cfg.walls[k].line, fmt::format("walls[{}]", k),
+                         fmt::format("wall \"{}\" does not enclose the grains: grain {} has a "
+                                     "material point at ({:.6g}, {:.6g}) m on its outer side",
+                                     wall.name, model.points.grain[p], model.points.x[p][0],
+                                     model.points.x[p][1]));
+  }
 }
 
 namespace {
@@ -212,7 +253,9 @@ class Outputs {
     csv_.open(csv_path_, std::ios::trunc);
     if (!csv_) throw std::runtime_error("cannot open " + csv_path_);
     csv_ << "step,time,dt,newton_iterations,linear_solves,kinetic_energy,elastic_energy,"
-            "total_energy,momentum_x,momentum_y,mass,volume\n";
+            "total_energy,momentum_x,momentum_y,mass,volume,contacts,active_contacts,gs_sweeps";
+    for (const auto& w : cfg.walls) csv_ << ",wall_" << w.name << "_fx,wall_" << w.name << "_fy";
+    csv_ << "\n";
     if (cfg_.output.vtu)
       pvd_ = std::make_unique<io::PvdSeries>(
           (fs::path(dir_) / (cfg.simulation.name + ".pvd")).string());
@@ -220,16 +263,73 @@ class Outputs {
   void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& st,
                const mpm::Diagnostics<2>& d) {
     csv_ << fmt::format(
-        "{},{:.12e},{:.6e},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}\n", step,
-        t, dt, st.iterations, st.linear_solves, d.kinetic, d.elastic, d.kinetic + d.elastic,
+        "{},{:.12e},{:.6e},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", step, t,
+        dt, st.iterations, st.linear_solves, d.kinetic, d.elastic, d.kinetic + d.elastic,
         d.momentum[0], d.momentum[1], d.mass, d.volume);
+    csv_ << fmt::format(",{},{},{}", st.contacts, st.active_contacts, st.gs_sweeps);
+    for (std::size_t k = 0; k < cfg_.walls.size(); ++k) {
+      const bool have = k < st.wall_force.size();
+      csv_ << fmt::format(",{:.12e},{:.12e}", have ? st.wall_force[k][0] : 0.0,
+                          have ? st.wall_force[k][1] : 0.0);
+    }
+    csv_ << "\n";
     csv_.flush();
   }
-  void vtu(const mpm::Model<2>& model, double t) {
+  void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver, double t) {
     if (!pvd_) return;
-    const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_++);
+    const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
     write_points_vtu(model, (fs::path(dir_) / name).string());
     pvd_->add(t, name);
+    if (solver.settings().contact.enabled) {
+      const std::string cname =
+          fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
+      const std::string pname =
+          fmt::format("{}_pairs_{:06d}.csv", cfg_.simulation.name, vtu_count_);
+      write_contacts(model, solver, (fs::path(dir_) / cname).string(),
+                     (fs::path(dir_) / pname).string());
+      if (!contacts_pvd_)
+        contacts_pvd_ = std::make_unique<io::PvdSeries>(
+            (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
+      contacts_pvd_->add(t, cname);
+    }
+    ++vtu_count_;
+  }
+  // Contacts as points at their nodes (normal, impulses, the two bodies; walls as -1 - index),
+  // and the per-pair aggregated contact force sum P / dt as a CSV.
+  void write_contacts(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
+                      const std::string& vtu_path, const std::string& csv_path) {
+    const auto& pb = solver.contact_problem();
+    io::VtuPointCloud vtu(pb.contacts.size());
+    auto& normal = vtu.add_array("normal", 3);
+    auto& pn = vtu.add_array("normal_impulse", 1);
+    auto& pt = vtu.add_array("tangential_impulse", 1);
+    auto& force = vtu.add_array("force", 3);
+    auto& gap = vtu.add_array("gap", 1);
+    auto& body_a = vtu.add_int_array("body_a");
+    auto& body_b = vtu.add_int_array("body_b");
+    std::map<std::pair<int, int>, Vec<2>> pairs;
+    const double inv_dt = pb.dt > 0 ? 1.0 / pb.dt : 0.0;
+    for (std::size_t i = 0; i < pb.contacts.size(); ++i) {
+      const auto& c = pb.contacts[i];
+      const auto& sb = pb.slots[c.b];
+      const Vec<2> x = model.grid.node_position(model.grid.node_coords(sb.node));
+      vtu.set_position(i, x[0], x[1]);
+      normal[3 * i] = c.normal[0];
+      normal[3 * i + 1] = c.normal[1];
+      pn[i] = c.impulse.dot(c.normal);
+      pt[i] = c.impulse[1] * c.normal[0] - c.impulse[0] * c.normal[1];  // along t = e_z x n
+      force[3 * i] = c.impulse[0] * inv_dt;
+      force[3 * i + 1] = c.impulse[1] * inv_dt;
+      gap[i] = c.gap;
+      body_a[i] = c.a >= 0 ? pb.slots[c.a].grain : -1 - c.wall;
+      body_b[i] = sb.grain;
+      pairs[{body_a[i], body_b[i]}] += c.impulse * inv_dt;
+    }
+    vtu.write(vtu_path);
+    std::string text = "body_a,body_b,force_x,force_y\n";
+    for (const auto& [key, f] : pairs)
+      text += fmt::format("{},{},{:.12e},{:.12e}\n", key.first, key.second, f[0], f[1]);
+    io::write_file_atomic(csv_path, text);
   }
   std::string last_good(const mpm::Model<2>& model) {
     const std::string path = (fs::path(dir_) / (cfg_.simulation.name + "_last_good.vtu")).string();
@@ -241,7 +341,7 @@ class Outputs {
   const io::Config& cfg_;
   std::string dir_, csv_path_;
   std::ofstream csv_;
-  std::unique_ptr<io::PvdSeries> pvd_;
+  std::unique_ptr<io::PvdSeries> pvd_, contacts_pvd_;
   int vtu_count_ = 0;
 };
 
@@ -253,6 +353,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
   if (threads > 0) omp_set_num_threads(threads);
   mpm::Model<2> model = build_model(cfg);  // may throw InputError: before any output
   auto settings = build_settings(cfg);
+  check_walls_enclose(cfg, model, settings);  // may throw InputError: before any output
   bool any_moving = false;
   for (const auto& b : cfg.boundaries) any_moving = any_moving || b.moving;
 
@@ -279,7 +380,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
       next_csv = t + cfg.output.csv_interval;
     }
     if (force || t >= next_vtu - eps) {
-      out.vtu(model, t);
+      out.vtu(model, solver, t);
       next_vtu = t + cfg.output.vtu_interval;
     }
   };
@@ -288,6 +389,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
   auto last_progress = wall0;
   while (t < t_end - 1e-9 * dt_nominal) {
     const double dt_try = std::min(dt, t_end - t);
+    solver.set_time(t);
     if (any_moving) solver.set_boundary_conditions(build_boundaries(cfg, model.grid, t + dt_try));
     mpm::StepStats st = solver.solve_step(dt_try);
     if (!st.converged) {

@@ -93,6 +93,8 @@ Schema build_schema() {
         KeySpec::subtable("loads", "loads", "body forces").defaults("its defaults"),
         KeySpec::subtable("time", "time", "time stepping").require(),
         KeySpec::subtable("solver", "solver", "Newton and linear solver").defaults("its defaults"),
+        KeySpec::subtable("contact", "contact", "Contact Dynamics").defaults("its defaults"),
+        KeySpec::table_array("walls", "walls[]", "rigid walls").defaults("none"),
         KeySpec::subtable("output", "output", "output files").defaults("its defaults")},
        ""});
 
@@ -279,6 +281,69 @@ Schema build_schema() {
        ""});
 
   s.tables.push_back(
+      {"contact",
+       "[contact]",
+       "Contact Dynamics between grains and with walls (method.md §4): Signorini non-penetration "
+       "and Coulomb friction, solved by nonlinear Gauss-Seidel staggered with the Newton "
+       "iterations. Candidates are grid nodes where two grain fields carry more than "
+       "`mass_fraction` of a full cell's mass, and grain nodes within `wall_range` cells of a "
+       "wall.",
+       {KeySpec::boolean("enabled", "solve contacts").defaults(boolean_text(d.contact.enabled)),
+        KeySpec::string("criterion",
+                        "grain-grain switch-on: \"gap\" (from the points' domains: when the "
+                        "materials meet) or \"overlap\" (any shared node: about a cell early)")
+            .one_of({"gap", "overlap"})
+            .defaults(str(d.contact.criterion)),
+        KeySpec::number("friction", "", "default grain-grain Coulomb coefficient mu_f")
+            .at_least(0.0)
+            .defaults(num(d.contact.friction)),
+        KeySpec::number("mass_fraction", "", "threshold of a field's nodal mass, in full cells")
+            .greater_than(0.0)
+            .at_most(1.0)
+            .defaults(num(d.contact.mass_fraction)),
+        KeySpec::number("tolerance", "", "Gauss-Seidel error tolerance")
+            .greater_than(0.0)
+            .defaults(num(d.contact.tolerance)),
+        KeySpec::integer("max_sweeps", "", "Gauss-Seidel sweep limit")
+            .at_least(1)
+            .defaults(num(d.contact.max_sweeps)),
+        KeySpec::number("impulse_tolerance", "",
+                        "relative change of impulses between Newton iterations")
+            .greater_than(0.0)
+            .defaults(num(d.contact.impulse_tolerance)),
+        KeySpec::number("wall_range", "", "grain nodes within this many cells of a wall")
+            .greater_than(0.0)
+            .at_most(3.0)
+            .defaults(num(d.contact.wall_range)),
+        KeySpec::table_array("pairs", "contact.pairs[]", "friction per pair of materials")
+            .defaults("none")},
+       ""});
+
+  s.tables.push_back(
+      {"contact.pairs[]",
+       "[[contact.pairs]]",
+       "Friction between two materials (overrides `contact.friction`).",
+       {KeySpec::strings("materials", "the two material names").require(),
+        KeySpec::number("friction", "", "Coulomb coefficient mu_f").require().at_least(0.0)},
+       ""});
+
+  s.tables.push_back(
+      {"walls[]",
+       "[[walls]]",
+       "A rigid plane wall of infinite mass: the plane through `point` + `velocity` t with "
+       "`normal` pointing into the domain. Every grain must start inside every wall.",
+       {KeySpec::string("name", "name used in the CSV columns (letters, digits, `_ -`)")
+            .require()
+            .nonempty(),
+        KeySpec::numbers("point", "Dim", "m", "a point of the plane at t = 0").require(),
+        KeySpec::numbers("normal", "Dim", "", "normal into the domain (normalised)").require(),
+        KeySpec::numbers("velocity", "Dim", "m/s", "prescribed velocity").defaults("zeros"),
+        KeySpec::number("friction", "", "Coulomb coefficient with the grains")
+            .at_least(0.0)
+            .defaults("0")},
+       ""});
+
+  s.tables.push_back(
       {"output",
        "[output]",
        "Where and how often to write. An interval of 0 means every step.",
@@ -323,6 +388,8 @@ class ConfigReader {
     if (c.loads.gravity.empty()) c.loads.gravity.assign(dim_, 0.0);
     read_time(r, c);
     read_solver(r, c);
+    read_contact(r, c);
+    read_walls(r, c);
     read_output(r, c);
     return c;
   }
@@ -602,6 +669,65 @@ class ConfigReader {
     r.read("cg_tolerance", s.cg_tolerance);
     r.read("cg_max_iterations", s.cg_max_iterations);
     r.read("flip", s.flip);
+  }
+
+  void read_contact(const TableReader& root, Config& c) {
+    TableReader r = sub(root, "contact", "contact");
+    ContactSection& k = c.contact;
+    r.read("enabled", k.enabled);
+    r.read("criterion", k.criterion);
+    r.read("friction", k.friction);
+    r.read("mass_fraction", k.mass_fraction);
+    r.read("tolerance", k.tolerance);
+    r.read("max_sweeps", k.max_sweeps);
+    r.read("impulse_tolerance", k.impulse_tolerance);
+    r.read("wall_range", k.wall_range);
+    const auto tables = r.table_array("pairs");
+    for (std::size_t i = 0; i < tables.size(); ++i) {
+      const toml::table& t = *tables[i];
+      TableReader q(t, schema_.table("contact.pairs[]"), ctx_, fmt::format("contact.pairs[{}]", i),
+                    line_of(t));
+      ContactPairSection pair;
+      pair.line = q.line();
+      q.read("materials", pair.materials);
+      q.read("friction", pair.friction);
+      if (pair.materials.size() != 2)
+        q.fail("materials",
+               fmt::format("expected 2 material names, got {}", pair.materials.size()));
+      for (const auto& m : pair.materials) {
+        bool known = false;
+        for (const auto& mat : c.materials) known = known || mat.name == m;
+        if (!known) q.fail("materials", fmt::format("unknown material \"{}\"", m));
+      }
+      k.pairs.push_back(std::move(pair));
+    }
+  }
+
+  void read_walls(const TableReader& root, Config& c) {
+    const auto tables = root.table_array("walls");
+    for (std::size_t i = 0; i < tables.size(); ++i) {
+      const toml::table& t = *tables[i];
+      TableReader r(t, schema_.table("walls[]"), ctx_, fmt::format("walls[{}]", i), line_of(t));
+      WallSection w;
+      w.line = r.line();
+      r.read("name", w.name);
+      r.read("point", w.point);
+      r.read("normal", w.normal);
+      r.read("velocity", w.velocity);
+      r.read("friction", w.friction);
+      if (w.velocity.empty()) w.velocity.assign(dim_, 0.0);
+      for (char ch : w.name)
+        if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_' && ch != '-')
+          r.fail("name", fmt::format("\"{}\": only letters, digits, '_' and '-'", w.name));
+      for (const auto& other : c.walls)
+        if (other.name == w.name) r.fail("name", fmt::format("duplicate wall name \"{}\"", w.name));
+      double len = 0;
+      for (double x : w.normal) len += x * x;
+      len = std::sqrt(len);
+      if (!(len > 0)) r.fail("normal", "expected a non-zero normal");
+      for (double& x : w.normal) x /= len;
+      c.walls.push_back(std::move(w));
+    }
   }
 
   void read_output(const TableReader& root, Config& c) {

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include "mpmcd/core/errors.hpp"
 
@@ -42,6 +43,11 @@ struct ImplicitSolver<Dim>::GrainWork {
   std::vector<Vec<Dim>> v;                // current iterate of v_I^{n+1} [m/s]
   std::vector<Vec<Dim>> f_n, f_ext, f_int, f_abs, R, du;  // f_abs: sum of |V sigma g| (scale)
   std::vector<std::uint8_t> mask;                         // prescribed components
+  std::vector<Vec<Dim>> P;       // contact impulse on each node over the step [N s]
+  std::vector<Vec<Dim>> grad_m;  // mass gradient sum m_p grad N_I(x_p) [kg/m]
+  std::vector<Vec<Dim>> box_gm;  // scratch for grad_m on the box
+  std::vector<std::int32_t> node_pts_start, node_pts;  // active node -> its points (CSR)
+  double contact_mass = 0;                // contact threshold: mass_fraction * a full cell's mass
   std::vector<IVec<Dim>> pt_first;        // per point: first support node (box coordinates)
   std::vector<std::int32_t> pt_node;      // per point x K: active node or -1
   std::vector<double> pt_N;               // per point x K: weights at x^n
@@ -161,6 +167,8 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   reset(w.box_mv, nb, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.box_f, nb, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.box_fext, nb, Vec<Dim>(Vec<Dim>::Zero()));
+  const bool contact = settings_.contact.enabled;
+  if (contact) reset(w.box_gm, nb, Vec<Dim>(Vec<Dim>::Zero()));
   // Pass 2: P2G (method.md §2): m_I = sum N m_p, m_I v_I = sum N m_p v_p,
   // f_I^n = -sum V_p sigma_p grad N_I (seed eq. 5) + sum N m_p g.
   for (std::int64_t i = 0; i < np; ++i) {
@@ -179,6 +187,7 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
       w.box_mv[b] += N * mv;
       w.box_f[b] -= Vs * w.pt_dN[i * K + a];
       w.box_fext[b] += N * mg;
+      if (contact) w.box_gm[b] += mp * w.pt_dN[i * K + a];  // grad m_I = sum m_p grad N_I (§4)
     }
   }
   // Keep the previous step's active set to reuse the sparse pattern when it has not changed.
@@ -193,6 +202,7 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   w.v_p2g.clear();
   w.f_n.clear();
   w.f_ext.clear();
+  w.grad_m.clear();
   // Active nodes carry more than round-off mass (uGIMP tails at a material edge lying on a grid
   // line give weights ~1e-17 that would only make the Newton matrix ill-conditioned).
   double mp_max = 0;
@@ -213,6 +223,7 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
     w.v_p2g.push_back(w.box_mv[b] / w.box_m[b]);
     w.f_n.push_back(w.box_f[b] + w.box_fext[b]);
     w.f_ext.push_back(w.box_fext[b]);
+    if (contact) w.grad_m.push_back(w.box_gm[b]);
   }
   const std::size_t na = w.m.size();
   for (std::int64_t i = 0; i < np; ++i) {
@@ -238,6 +249,28 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   w.v = w.v_n;  // initial guess: zero acceleration
   reset(w.f_int, na, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.f_abs, na, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.P, na, Vec<Dim>(Vec<Dim>::Zero()));
+  if (contact) {
+    // Node -> points lists (for the gaps) and the contact mass threshold of this grain.
+    double m_sum = 0, v_sum = 0;
+    for (std::int64_t i = 0; i < np; ++i) {
+      m_sum += points_.mass[gr.begin + i];
+      v_sum += points_.volume0[gr.begin + i];
+    }
+    w.contact_mass = settings_.contact.mass_fraction * m_sum / v_sum * std::pow(h, Dim);
+    w.node_pts_start.assign(na + 1, 0);
+    for (std::int64_t i = 0; i < np; ++i)
+      for (int a = 0; a < K; ++a)
+        if (w.pt_node[i * K + a] >= 0 && w.pt_N[i * K + a] > 0)
+          ++w.node_pts_start[w.pt_node[i * K + a] + 1];
+    for (std::size_t a = 0; a < na; ++a) w.node_pts_start[a + 1] += w.node_pts_start[a];
+    w.node_pts.resize(w.node_pts_start[na]);
+    std::vector<std::int32_t> fill(w.node_pts_start.begin(), w.node_pts_start.end() - 1);
+    for (std::int64_t i = 0; i < np; ++i)
+      for (int a = 0; a < K; ++a)
+        if (w.pt_node[i * K + a] >= 0 && w.pt_N[i * K + a] > 0)
+          w.node_pts[fill[w.pt_node[i * K + a]]++] = static_cast<std::int32_t>(i);
+  }
   reset(w.R, na, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.du, na, Vec<Dim>(Vec<Dim>::Zero()));
   (void)dt;
@@ -373,10 +406,11 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
   // Residual R_I = m_I (v^{n+1} - v^n) - dt [(1 - theta) f^n + theta f^{n+1}] (method.md §2).
   // Reference scale: inertia, nodal forces and the magnitude of the stress contributions, so that
   // the tolerance stays above round-off when large point forces cancel at a node.
-  double r2 = 0, mv2 = 0, fn2 = 0, fi2 = 0, fe2 = 0, fa2 = 0;
+  double r2 = 0, mv2 = 0, fn2 = 0, fi2 = 0, fe2 = 0, fa2 = 0, p2 = 0;
   for (std::size_t a = 0; a < na; ++a) {
+    // ... - P_I: the contact impulse over the step (method.md §2, §4)
     Vec<Dim> r = w.m[a] * (w.v[a] - w.v_n[a]) -
-                 dt * ((1.0 - theta) * w.f_n[a] + theta * (w.f_int[a] + w.f_ext[a]));
+                 dt * ((1.0 - theta) * w.f_n[a] + theta * (w.f_int[a] + w.f_ext[a])) - w.P[a];
     for (int d = 0; d < Dim; ++d)
       if (w.mask[a] & (1u << d)) r[d] = 0.0;
     w.R[a] = r;
@@ -386,10 +420,11 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
     fi2 += w.f_int[a].squaredNorm();
     fe2 += w.f_ext[a].squaredNorm();
     fa2 += w.f_abs[a].squaredNorm();
+    p2 += w.P[a].squaredNorm();
   }
   w.res_norm = std::sqrt(r2);
-  w.res_ref =
-      std::sqrt(mv2) + dt * (std::sqrt(fn2) + std::sqrt(fi2) + std::sqrt(fe2) + std::sqrt(fa2));
+  w.res_ref = std::sqrt(mv2) + std::sqrt(p2) +
+              dt * (std::sqrt(fn2) + std::sqrt(fi2) + std::sqrt(fe2) + std::sqrt(fa2));
   if (!std::isfinite(w.res_norm)) {
     w.failure = "non-finite residual";
     return;
@@ -556,6 +591,15 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     }
   }
   if (collect_failure()) return stats;
+  const bool contact = settings_.contact.enabled;
+  if (contact) {
+    ScopedStage t(&timers_, "contact.detect");
+    detect_contacts(dt);
+  } else {
+    problem_.contacts.clear();
+    problem_.slots.clear();
+  }
+  double impulse_change = 0;
   for (int it = 0; it <= settings_.max_iterations; ++it) {
     {
       ScopedStage t(&timers_, "newton.assemble");
@@ -579,7 +623,11 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       all = all && work_[g]->converged;
     }
     stats.residual_history.push_back(worst);
-    if (all) {
+    // Staggered with Newton: the step has converged when the grains have (with the current
+    // impulses) and the impulses have stopped changing (method.md §4).
+    const bool impulses_ok = problem_.contacts.empty() ||
+                             (it > 0 && impulse_change <= settings_.contact.impulse_tolerance);
+    if (all && impulses_ok) {
       stats.converged = true;
       break;
     }
@@ -593,6 +641,10 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       }
     }
     if (collect_failure()) return stats;
+    if (!problem_.contacts.empty()) {
+      ScopedStage t(&timers_, "contact.solve");
+      impulse_change = update_contacts(stats);
+    }
   }
   for (std::size_t g = 0; g < ng; ++g) {
     stats.iterations = std::max(stats.iterations, work_[g]->iterations);
@@ -609,9 +661,218 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
                     settings_.max_iterations,
                     stats.residual_history.empty() ? 0.0 : stats.residual_history.back());
     return stats;
+  }  // Contact summary: active contacts and the force of the grains on each wall (-P/dt).
+  stats.contacts = static_cast<std::int64_t>(problem_.contacts.size());
+  stats.wall_force.assign(settings_.contact.walls.size(), {0.0, 0.0, 0.0});
+  previous_.clear();
+  for (const auto& c : problem_.contacts) {
+    if (c.impulse.dot(c.normal) > 0) ++stats.active_contacts;
+    if (c.a < 0)
+      for (int d = 0; d < Dim; ++d) stats.wall_force[c.wall][d] -= c.impulse[d] / dt;
+    const std::int32_t a = c.a < 0 ? -1 - c.wall : problem_.slots[c.a].grain;
+    previous_.push_back({problem_.slots[c.b].node, a, problem_.slots[c.b].grain, c.impulse});
   }
+  std::sort(previous_.begin(), previous_.end(), [](const PrevImpulse& x, const PrevImpulse& y) {
+    return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
+  });
   step_ready_ = true;
   return stats;
+}
+
+template <int Dim>
+std::int32_t ImplicitSolver<Dim>::slot_of(std::int32_t g, std::int32_t a) {
+  const std::int64_t node = work_[g]->node_global[a];
+  if (slot_stamp_[node] != stamp_) {
+    slot_stamp_[node] = stamp_;
+    slot_head_[node] = -1;
+  }
+  for (std::int32_t s = slot_head_[node]; s >= 0; s = slot_next_[s])
+    if (slot_ref_[s].first == g) return s;
+  const auto s = static_cast<std::int32_t>(problem_.slots.size());
+  const GrainWork& w = *work_[g];
+  problem_.slots.push_back({w.m[a], w.v[a], g, node});
+  slot_ref_.emplace_back(g, a);
+  slot_next_.push_back(slot_head_[node]);
+  slot_head_[node] = s;
+  return s;
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::detect_contacts(double dt) {
+  const ContactSettings<Dim>& cs = settings_.contact;
+  const double h = grid_.cell_size();
+  problem_.dt = dt;
+  problem_.slots.clear();
+  problem_.contacts.clear();
+  slot_ref_.clear();
+  slot_next_.clear();
+  const auto nn = static_cast<std::size_t>(grid_.node_count());
+  if (node_stamp_.size() != nn) {
+    node_stamp_.assign(nn, 0);
+    slot_stamp_.assign(nn, 0);
+    node_head_.assign(nn, -1);
+    slot_head_.assign(nn, -1);
+  }
+  ++stamp_;
+  const auto warm = [&](std::int64_t node, std::int32_t a, std::int32_t b) -> Vec<Dim> {
+    const PrevImpulse key{node, a, b, Vec<Dim>::Zero()};
+    auto it = std::lower_bound(previous_.begin(), previous_.end(), key,
+                               [](const PrevImpulse& x, const PrevImpulse& y) {
+                                 return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
+                               });
+    if (it != previous_.end() && it->node == node && it->a == a && it->b == b) return it->impulse;
+    return Vec<Dim>::Zero();
+  };
+  // Extent of point p's domain (a square of half-width lp mapped by F) along the unit vector n:
+  // lp sum_i |(F^T n)_i| [m].
+  const auto extent = [&](std::int64_t p, double lp, const Vec<Dim>& n) {
+    return lp * (points_.F[p].transpose() * n).cwiseAbs().sum();
+  };
+  // 1. Grain fields carrying mass at each node: linked entries per global node.
+  struct Entry {
+    std::int32_t g, a, next;
+  };
+  std::vector<Entry> entries;
+  std::vector<std::int64_t> shared;
+  for (std::size_t g = 0; g < work_.size(); ++g) {
+    const GrainWork& w = *work_[g];
+    for (std::size_t a = 0; a < w.m.size(); ++a) {
+      if (w.m[a] < w.contact_mass) continue;
+      const std::int64_t n = w.node_global[a];
+      if (node_stamp_[n] != stamp_) {
+        node_stamp_[n] = stamp_;
+        node_head_[n] = -1;
+      }
+      const std::int32_t head = node_head_[n];
+      if (head >= 0 && entries[head].next < 0) shared.push_back(n);  // second field here
+      entries.push_back({static_cast<std::int32_t>(g), static_cast<std::int32_t>(a), head});
+      node_head_[n] = static_cast<std::int32_t>(entries.size()) - 1;
+    }
+  }
+  // 2. Grain-grain contacts: every pair of fields at a shared node (three grains: three pairs).
+  for (std::int64_t n : shared)
+    for (std::int32_t e1 = node_head_[n]; e1 >= 0; e1 = entries[e1].next)
+      for (std::int32_t e2 = entries[e1].next; e2 >= 0; e2 = entries[e2].next) {
+        Entry A = entries[e1], B = entries[e2];
+        if (A.g > B.g) std::swap(A, B);
+        const GrainWork& wa = *work_[A.g];
+        const GrainWork& wb = *work_[B.g];
+        // normal from A to B: n ∝ grad m^B - grad m^A (method.md §4)
+        Vec<Dim> normal = wb.grad_m[B.a] - wa.grad_m[A.a];
+        const double len = normal.norm();
+        if (!(len > 1e-12 * (wa.grad_m[A.a].norm() + wb.grad_m[B.a].norm()))) continue;
+        normal /= len;
+        double gap = 0;
+        if (cs.criterion == GapCriterion::kGap) {
+          // gap between the extreme point surfaces of A and B along n near the node
+          const double lpa = grains_[A.g].half_width, lpb = grains_[B.g].half_width;
+          double sa = -std::numeric_limits<double>::infinity();
+          double sb = std::numeric_limits<double>::infinity();
+          for (std::int32_t k = wa.node_pts_start[A.a]; k < wa.node_pts_start[A.a + 1]; ++k) {
+            const std::int64_t p = grains_[A.g].begin + wa.node_pts[k];
+            sa = std::max(sa, points_.x[p].dot(normal) + extent(p, lpa, normal));
+          }
+          for (std::int32_t k = wb.node_pts_start[B.a]; k < wb.node_pts_start[B.a + 1]; ++k) {
+            const std::int64_t p = grains_[B.g].begin + wb.node_pts[k];
+            sb = std::min(sb, points_.x[p].dot(normal) - extent(p, lpb, normal));
+          }
+          gap = std::max(0.0, sb - sa);
+        }
+        contact::Contact<Dim> c;
+        c.a = slot_of(A.g, A.a);
+        c.b = slot_of(B.g, B.a);
+        c.normal = normal;
+        c.gap = gap;
+        c.friction = cs.friction[grains_[A.g].material * cs.materials + grains_[B.g].material];
+        c.impulse = warm(n, A.g, B.g);
+        problem_.contacts.push_back(c);
+      }
+  // 3. Grain-wall contacts: grain nodes within wall_range cells of a wall; gap from the points.
+  for (std::size_t wi = 0; wi < cs.walls.size(); ++wi) {
+    const Wall<Dim>& wall = cs.walls[wi];
+    for (std::size_t g = 0; g < work_.size(); ++g) {
+      const GrainWork& w = *work_[g];
+      const double lp = grains_[g].half_width;
+      for (std::size_t a = 0; a < w.m.size(); ++a) {
+        if (w.m[a] < w.contact_mass) continue;
+        const Vec<Dim> xn = grid_.node_position(grid_.node_coords(w.node_global[a]));
+        if (wall.distance(xn, time_) > cs.wall_range * h) continue;
+        double gap = std::numeric_limits<double>::infinity();
+        for (std::int32_t k = w.node_pts_start[a]; k < w.node_pts_start[a + 1]; ++k) {
+          const std::int64_t p = grains_[g].begin + w.node_pts[k];
+          gap = std::min(gap, wall.distance(points_.x[p], time_) - extent(p, lp, wall.normal));
+        }
+        if (!std::isfinite(gap)) continue;
+        contact::Contact<Dim> c;
+        c.a = -1;
+        c.wall = static_cast<std::int32_t>(wi);
+        c.b = slot_of(static_cast<std::int32_t>(g), static_cast<std::int32_t>(a));
+        c.normal = wall.normal;
+        c.wall_velocity = wall.velocity;
+        c.gap = std::max(0.0, gap);
+        c.friction = wall.friction;
+        c.impulse = warm(w.node_global[a], -1 - static_cast<std::int32_t>(wi),
+                         static_cast<std::int32_t>(g));
+        problem_.contacts.push_back(c);
+      }
+    }
+  }
+  // Warm start: the grains see the previous step's impulses from the first iteration on.
+  std::vector<Vec<Dim>> slot_p(problem_.slots.size(), Vec<Dim>::Zero());
+  for (const auto& c : problem_.contacts) {
+    slot_p[c.b] += c.impulse;
+    if (c.a >= 0) slot_p[c.a] -= c.impulse;
+  }
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
+    work_[slot_ref_[s].first]->P[slot_ref_[s].second] = slot_p[s];
+  gs_converged_ = true;
+}
+
+template <int Dim>
+double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
+  // Free velocities: the grains' current iterates without the contact impulses (lumped, §4).
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
+    const GrainWork& w = *work_[slot_ref_[s].first];
+    const std::int32_t a = slot_ref_[s].second;
+    problem_.slots[s].v_free = w.v[a] - w.P[a] / w.m[a];
+  }
+  std::vector<Vec<Dim>> old(problem_.contacts.size());
+  for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
+  const contact::GsResult r = contact::solve_gauss_seidel(problem_, settings_.contact.gs);
+  stats.gs_sweeps += r.sweeps;
+  stats.gs_error = r.error;
+  gs_converged_ = r.converged;
+  double num = 0, den = 0;
+  std::vector<Vec<Dim>> slot_p(problem_.slots.size(), Vec<Dim>::Zero());
+  for (std::size_t c = 0; c < old.size(); ++c) {
+    const auto& ct = problem_.contacts[c];
+    num += (ct.impulse - old[c]).squaredNorm();
+    den += ct.impulse.squaredNorm();
+    slot_p[ct.b] += ct.impulse;
+    if (ct.a >= 0) slot_p[ct.a] -= ct.impulse;
+  }
+  // The impulses enter the grains' residuals; their nodes move with the lumped update
+  // v = v_free + P/m, and a grain whose impulses changed is iterated again.
+  std::vector<double> dv2(work_.size(), -1.0);
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
+    GrainWork& w = *work_[slot_ref_[s].first];
+    const std::int32_t a = slot_ref_[s].second;
+    if (slot_p[s] == w.P[a]) continue;
+    w.P[a] = slot_p[s];
+    const Vec<Dim> v_new = problem_.slots[s].v_free + slot_p[s] / w.m[a];
+    double& acc = dv2[slot_ref_[s].first];
+    acc = std::max(acc, 0.0) + w.m[a] * (v_new - w.v[a]).squaredNorm();
+    w.v[a] = v_new;
+  }
+  for (std::size_t g = 0; g < work_.size(); ++g)
+    if (dv2[g] >= 0.0) {
+      work_[g]->converged = false;
+      work_[g]->solved_once = true;
+      work_[g]->dv_norm = std::sqrt(dv2[g]);
+    }
+  if (num == 0.0) return gs_converged_ ? 0.0 : 1.0;
+  const double change = std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
+  return gs_converged_ ? change : std::max(change, 1.0);
 }
 
 template <int Dim>

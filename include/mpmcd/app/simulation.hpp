@@ -41,6 +41,10 @@ std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& config,
 /// Solver settings from the input.
 mpm::Settings<2> build_settings(const io::Config& config);
 
+/// Throws InputError if a material point starts outside a wall (walls must enclose the grains).
+void check_walls_enclose(const io::Config& config, const mpm::Model<2>& model,
+                         const mpm::Settings<2>& settings);
+
 /// Runs the whole simulation; throws InputError (exit 2) or NumericalError (exit 3, after writing
 /// the last good state).
 RunSummary run_simulation(const io::Config& config, const RunOptions& options);

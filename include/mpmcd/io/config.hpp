@@ -98,6 +98,36 @@ struct SolverSection {
   double flip = 1.0;  ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
 };
 
+/// [[contact.pairs]]: friction between two materials.
+struct ContactPairSection {
+  std::vector<std::string> materials;  ///< the two material names (may be equal)
+  double friction = 0.0;               ///< Coulomb coefficient mu_f [-]
+  std::int64_t line = 0;               ///< line of the table in the input
+};
+
+/// [contact]: Contact Dynamics between grains and with walls (method.md §4).
+struct ContactSection {
+  bool enabled = true;            ///< solve contacts (grain-grain and grain-wall) [-]
+  std::string criterion = "gap";  ///< "gap" (points' domains) or "overlap" (support overlap)
+  double friction = 0.0;          ///< default grain-grain Coulomb coefficient [-]
+  double mass_fraction = 1e-3;    ///< contact node: field mass above this fraction of a cell's [-]
+  double tolerance = 1e-8;        ///< Gauss-Seidel error tolerance [-]
+  int max_sweeps = 1000;          ///< Gauss-Seidel sweep limit [-]
+  double impulse_tolerance = 1e-6;  ///< relative impulse change between Newton iterations [-]
+  double wall_range = 1.0;          ///< grain nodes within this many cells of a wall take part [-]
+  std::vector<ContactPairSection> pairs;  ///< per material-pair friction
+};
+
+/// [[walls]]: a rigid plane wall of infinite mass with a prescribed velocity.
+struct WallSection {
+  std::string name;              ///< name used in the CSV columns [-]
+  std::vector<double> point;     ///< a point of the plane at t = 0 [m], Dim entries
+  std::vector<double> normal;    ///< normal pointing into the domain (normalised) [-], Dim entries
+  std::vector<double> velocity;  ///< prescribed velocity [m/s], Dim entries (default 0)
+  double friction = 0.0;         ///< Coulomb coefficient with the grains [-]
+  std::int64_t line = 0;         ///< line of the table in the input
+};
+
 /// [output]: where and how often to write.
 struct OutputSection {
   std::string folder = "output";   ///< output folder (created) [-]
@@ -119,6 +149,8 @@ struct Config {
   LoadsSection loads;
   TimeSection time;
   SolverSection solver;
+  ContactSection contact;
+  std::vector<WallSection> walls;
   OutputSection output;
 };
 

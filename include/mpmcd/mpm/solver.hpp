@@ -1,11 +1,13 @@
 #pragma once
 /// The implicit theta-method MPM step (method.md §2): P2G per grain, Newton-Raphson on end-of-step
 /// nodal velocities with the consistent tangent, per-grain sparse linear solves, G2P on commit.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "mpmcd/contact/problem.hpp"
 #include "mpmcd/core/timer.hpp"
 #include "mpmcd/core/types.hpp"
 #include "mpmcd/grid/grid.hpp"
@@ -25,6 +27,43 @@ enum class LinearSolverKind {
 /// Parses "ldlt" / "lu" / "cg"; throws InputError otherwise.
 LinearSolverKind linear_solver_from_string(const std::string& name);
 
+/// A rigid wall: the plane through `point` + velocity t with unit `normal` pointing into the
+/// domain; it takes part in contact as a body of infinite mass.
+template <int Dim>
+struct Wall {
+  std::string name;                      ///< name used in outputs
+  Vec<Dim> point = Vec<Dim>::Zero();     ///< a point of the plane at t = 0 [m]
+  Vec<Dim> normal = Vec<Dim>::Zero();    ///< unit normal into the domain [-]
+  Vec<Dim> velocity = Vec<Dim>::Zero();  ///< prescribed velocity [m/s]
+  double friction = 0.0;                 ///< Coulomb coefficient with every grain [-]
+  /// Signed distance of x [m] from the wall at time t [s] (positive inside the domain) [m].
+  double distance(const Vec<Dim>& x, double t) const {
+    return (x - point - t * velocity).dot(normal);
+  }
+};
+
+/// When a grain-grain contact switches on (method.md §4).
+enum class GapCriterion {
+  kGap,      ///< gap from the points' domains: contact when the materials meet
+  kOverlap,  ///< pure support overlap: any node where both fields carry mass (about a cell early)
+};
+
+/// Contact Dynamics settings (method.md §4).
+template <int Dim>
+struct ContactSettings {
+  bool enabled = false;                         ///< solve contacts between grains and with walls
+  GapCriterion criterion = GapCriterion::kGap;  ///< grain-grain gap criterion
+  double mass_fraction =
+      1e-3;           ///< a field takes part at a node above this fraction of a cell's mass
+  int materials = 1;  ///< number of materials (size of the friction matrix)
+  std::vector<double> friction = {
+      0.0};                         ///< mu_f per material pair, row-major materials x materials
+  std::vector<Wall<Dim>> walls;     ///< rigid walls
+  double wall_range = 1.0;          ///< grain nodes within this many cells of a wall are candidates
+  contact::GsSettings gs;           ///< Gauss-Seidel tolerance and sweep limit
+  double impulse_tolerance = 1e-6;  ///< relative change of impulses between Newton iterations [-]
+};
+
 /// Numerical settings of the implicit step.
 template <int Dim>
 struct Settings {
@@ -38,6 +77,7 @@ struct Settings {
   int cg_max_iterations = 1000;                              ///< CG iteration cap [-]
   double flip = 1.0;                    ///< FLIP fraction of the G2P velocity update [-]
   Vec<Dim> gravity = Vec<Dim>::Zero();  ///< body acceleration [m/s^2]
+  ContactSettings<Dim> contact;         ///< contact between grains and with walls
 };
 
 /// Prescribed velocity components on a set of grid nodes: v(x) = velocity + gradient (x - anchor).
@@ -59,12 +99,18 @@ struct StepStats {
   std::int64_t linear_solves = 0;        ///< linear solves, summed over grains
   std::vector<double> residual_history;  ///< per iteration: max over grains of |R| / reference
   std::string failure;                   ///< why the step failed ("" if converged)
-  bool retryable = true;    ///< false if a smaller dt cannot help (a point left the grid)
-  std::int64_t grain = -1;  ///< grain involved in the failure, -1 if none
-  std::int64_t point = -1;  ///< point involved in the failure, -1 if none
+  bool retryable = true;             ///< false if a smaller dt cannot help (a point left the grid)
+  std::int64_t grain = -1;           ///< grain involved in the failure, -1 if none
+  std::int64_t point = -1;           ///< point involved in the failure, -1 if none
+  std::int64_t contacts = 0;         ///< contact candidates (grain-grain and grain-wall)
+  std::int64_t active_contacts = 0;  ///< contacts with a positive normal impulse
+  std::int64_t gs_sweeps = 0;        ///< Gauss-Seidel sweeps, summed over Newton iterations
+  double gs_error = 0;               ///< final Gauss-Seidel error measure [-]
+  std::vector<std::array<double, 3>>
+      wall_force;  ///< force of the grains on each wall [N] (2D: N/m)
 };
 
-/// Implicit MPM stepper for independent grains (contact couples them in a later stage).
+/// Implicit MPM stepper: grains with their own nodal fields, coupled by Contact Dynamics.
 /// Holds non-owning references to the points, grains and laws, which must outlive it.
 template <int Dim>
 class ImplicitSolver {
@@ -79,6 +125,10 @@ class ImplicitSolver {
 
   /// Replaces the nodal velocity boundary conditions (later sets override earlier ones).
   void set_boundary_conditions(const std::vector<VelocityBC<Dim>>& bcs);
+  /// Sets the time t^n [s] of the next step (wall positions).
+  void set_time(double t) { time_ = t; }
+  /// The contact problem of the last step (impulses solved), for output and replay.
+  const contact::Problem<Dim>& contact_problem() const { return problem_; }
   /// Attempts the step t -> t + dt [s] from the committed point state; changes no point data.
   StepStats solve_step(double dt);
   /// Commits the last converged step: G2P positions and velocities, F, stress, volume, history.
@@ -103,6 +153,9 @@ class ImplicitSolver {
   template <class S1>
   void assemble_tangent(std::size_t g);
   void solve_grain(std::size_t g, double dt);
+  void detect_contacts(double dt);
+  double update_contacts(StepStats& stats);
+  std::int32_t slot_of(std::int32_t g, std::int32_t a);
   template <class S1>
   void commit_grain(std::size_t g);
 
@@ -120,6 +173,21 @@ class ImplicitSolver {
   std::vector<Mat<Dim>> F_trial_, sigma_trial_, dF_inv_T_;
   std::vector<double> sigma_zz_trial_, J_trial_, history_trial_;
   std::vector<Tensor4<Dim>> tangent_;
+  // Contact state: the problem of the step, slot -> (grain, active node), warm-start impulses.
+  contact::Problem<Dim> problem_;
+  std::vector<std::pair<std::int32_t, std::int32_t>> slot_ref_;
+  std::vector<std::uint32_t> node_stamp_, slot_stamp_;  // per global node: step stamp
+  std::vector<std::int32_t> node_head_, slot_head_;     // per global node: first entry / slot
+  std::vector<std::int32_t> slot_next_;                 // per slot: next slot at the same node
+  std::uint32_t stamp_ = 0;
+  bool gs_converged_ = true;
+  struct PrevImpulse {
+    std::int64_t node;
+    std::int32_t a, b;
+    Vec<Dim> impulse;
+  };
+  std::vector<PrevImpulse> previous_;  // sorted by (node, a, b)
+  double time_ = 0.0;
   double dt_ = 0.0;
   bool step_ready_ = false;
   StageTimers timers_;

@@ -1,0 +1,86 @@
+#pragma once
+/// The contact problem of one step as plain data (method.md §4), its exact local Signorini-Coulomb
+/// solver with the lumped Delassus operator, the nonlinear Gauss-Seidel over all contacts, and the
+/// one error measure shared by the solver and the tests. It can be written to a file and replayed.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mpmcd/core/types.hpp"
+
+namespace mpmcd::contact {
+
+/// A grain-field node taking part in contacts.
+template <int Dim>
+struct Slot {
+  double mass = 0;                     ///< nodal mass m_I of the grain field [kg]
+  Vec<Dim> v_free = Vec<Dim>::Zero();  ///< end-of-step velocity without contact impulses [m/s]
+  std::int32_t grain = -1;             ///< grain owning the field (information only)
+  std::int64_t node = -1;              ///< global grid node (information only)
+};
+
+/// One contact between slot A (or a wall, a = -1) and slot B; the impulse acts on B, its opposite
+/// on A.
+template <int Dim>
+struct Contact {
+  std::int32_t a = -1;                        ///< slot of body A, -1 for a wall (infinite mass)
+  std::int32_t b = -1;                        ///< slot of body B
+  std::int32_t wall = -1;                     ///< wall index when a = -1
+  Vec<Dim> normal = Vec<Dim>::Zero();         ///< unit normal from A to B
+  Vec<Dim> wall_velocity = Vec<Dim>::Zero();  ///< velocity of the wall when a = -1 [m/s]
+  double gap = 0;                             ///< g+ >= 0: A and B may approach by g this step [m]
+  double friction = 0;                        ///< Coulomb coefficient mu_f [-]
+  Vec<Dim> impulse = Vec<Dim>::Zero();        ///< impulse on B over the step (in: warm start) [N s]
+};
+
+/// The whole problem of a step.
+template <int Dim>
+struct Problem {
+  double dt = 0;                       ///< time step [s]
+  std::vector<Slot<Dim>> slots;        ///< nodes taking part
+  std::vector<Contact<Dim>> contacts;  ///< contacts (their impulses are the unknowns)
+};
+
+/// Gauss-Seidel settings.
+struct GsSettings {
+  double tolerance = 1e-8;  ///< stop when error(problem) <= tolerance [-]
+  int max_sweeps = 1000;    ///< sweep limit [-]
+};
+
+/// Gauss-Seidel outcome.
+struct GsResult {
+  int sweeps = 0;          ///< sweeps done
+  double error = 0;        ///< final error(problem) [-]
+  bool converged = false;  ///< error <= tolerance
+};
+
+/// Exact solution of one contact's local problem u = u_free + w P (lumped Delassus W = w I):
+/// open if the trial normal impulse -(u_free.n + g/dt)/w is negative, else stick if the stick
+/// impulse lies in the Coulomb cone |p_t| <= mu p_n, else slide with p_t = -mu p_n u_t/|u_t|
+/// (method.md §4).
+template <int Dim>
+Vec<Dim> local_solution(const Vec<Dim>& u_free, double w, const Vec<Dim>& n, double gap_over_dt,
+                        double mu);
+
+/// Error measure shared by the solver and the tests: with the slot velocities implied by the
+/// current impulses, sqrt(sum_c |P_c - local_c(P)|^2) / sqrt(sum_c |P_c|^2), where local_c is the
+/// exact local solution of contact c with all other impulses fixed (0 when every impulse is 0 and
+/// stays 0).
+template <int Dim>
+double error(const Problem<Dim>& problem);
+
+/// Nonlinear Gauss-Seidel: sweeps the contacts in order, each solved exactly with the others'
+/// current impulses, until error(problem) <= tolerance or max_sweeps; starts from the impulses in
+/// `problem`.
+template <int Dim>
+GsResult solve_gauss_seidel(Problem<Dim>& problem, const GsSettings& settings);
+
+/// Writes the problem as text (one line per slot and contact, 17 significant digits).
+template <int Dim>
+void write_problem(const Problem<Dim>& problem, const std::string& path);
+
+/// Reads a problem written by write_problem; throws InputError on malformed files.
+template <int Dim>
+Problem<Dim> read_problem(const std::string& path);
+
+}  // namespace mpmcd::contact

@@ -1,0 +1,97 @@
+// The local Signorini-Coulomb solution, the Gauss-Seidel solver and the problem file round trip.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+#include "mpmcd/contact/problem.hpp"
+
+using namespace mpmcd;
+using contact::local_solution;
+
+TEST(LocalSolver, OpenStickSlide) {
+  const Vec<2> n(0, 1);
+  const double w = 2.0;
+  // separating: open
+  EXPECT_EQ(local_solution<2>(Vec<2>(0.3, 1.0), w, n, 0.0, 0.5), Vec<2>::Zero());
+  // approaching slower than the gap allows: open
+  EXPECT_EQ(local_solution<2>(Vec<2>(0.0, -1.0), w, n, 1.5, 0.5), Vec<2>::Zero());
+  // approaching, small tangential velocity: stick, u = u_free + w P = 0
+  Vec<2> u(0.1, -1.0);
+  Vec<2> P = local_solution<2>(u, w, n, 0.0, 0.5);
+  EXPECT_LT((u + w * P).norm(), 1e-15);
+  // gap: u_n + g/dt = 0 after the impulse
+  P = local_solution<2>(Vec<2>(0.0, -1.0), w, n, 0.25, 0.5);
+  EXPECT_NEAR((Vec<2>(0.0, -1.0) + w * P).dot(n) + 0.25, 0.0, 1e-15);
+  // large tangential velocity: slide on the cone, p_t opposes u_t
+  u = Vec<2>(3.0, -1.0);
+  P = local_solution<2>(u, w, n, 0.0, 0.5);
+  EXPECT_NEAR(P[1], 0.5, 1e-15);
+  EXPECT_NEAR(P[0], -0.5 * 0.5, 1e-15);
+  EXPECT_GT((u + w * P)[0], 0.0);  // still sliding the same way
+  // frictionless: never a tangential impulse
+  P = local_solution<2>(Vec<2>(3.0, -1.0), w, n, 0.0, 0.0);
+  EXPECT_EQ(P[0], 0.0);
+}
+
+namespace {
+// A column of 5 stacked "nodes" pressed on a wall: slot k above slot k-1, wall below slot 0.
+contact::Problem<2> stack(double mu) {
+  contact::Problem<2> p;
+  p.dt = 1e-3;
+  for (int k = 0; k < 5; ++k) p.slots.push_back({1.0 + k, Vec<2>(0.2 * k, -1.0 - k), k, k});
+  contact::Contact<2> c;
+  c.a = -1;
+  c.b = 0;
+  c.wall = 0;
+  c.normal = Vec<2>(0, 1);
+  c.friction = mu;
+  p.contacts.push_back(c);
+  for (int k = 1; k < 5; ++k) {
+    c.a = k - 1;
+    c.b = k;
+    c.wall = -1;
+    p.contacts.push_back(c);
+  }
+  return p;
+}
+}  // namespace
+
+TEST(GaussSeidel, StackOnWallConvergesToNoPenetration) {
+  for (double mu : {0.0, 0.3}) {
+    auto p = stack(mu);
+    auto r = contact::solve_gauss_seidel(p, {1e-12, 10000});
+    ASSERT_TRUE(r.converged) << r.sweeps << " " << r.error;
+    std::printf("  stack, mu = %.1f: %d sweeps, error %.2e\n", mu, r.sweeps, r.error);
+    // all normal velocities >= 0 (no approach), total vertical momentum absorbed by the wall
+    std::vector<Vec<2>> v;
+    for (const auto& s : p.slots) v.push_back(s.v_free);
+    for (const auto& c : p.contacts) {
+      v[c.b] += c.impulse / p.slots[c.b].mass;
+      if (c.a >= 0) v[c.a] -= c.impulse / p.slots[c.a].mass;
+    }
+    for (const auto& c : p.contacts) {
+      const double un = (v[c.b] - (c.a >= 0 ? v[c.a] : Vec<2>::Zero())).dot(c.normal);
+      EXPECT_GT(un, -1e-9);
+      EXPECT_GE(c.impulse[1], 0.0);
+      EXPECT_LE(std::abs(c.impulse[0]), mu * c.impulse[1] + 1e-12);
+    }
+    EXPECT_EQ(contact::error(p), r.error);
+  }
+}
+
+TEST(GaussSeidel, ReplayedProblemGivesTheSameImpulses) {
+  auto p = stack(0.3);
+  const auto path = (std::filesystem::temp_directory_path() / "mpmcd_contact_problem.txt").string();
+  contact::write_problem(p, path);  // warm start = 0
+  auto r1 = contact::solve_gauss_seidel(p, {1e-10, 10000});
+  auto q = contact::read_problem<2>(path);
+  auto r2 = contact::solve_gauss_seidel(q, {1e-10, 10000});
+  ASSERT_TRUE(r1.converged && r2.converged);
+  double norm = 0, diff = 0;
+  for (std::size_t c = 0; c < p.contacts.size(); ++c) {
+    diff += (p.contacts[c].impulse - q.contacts[c].impulse).squaredNorm();
+    norm += p.contacts[c].impulse.squaredNorm();
+  }
+  EXPECT_LE(std::sqrt(diff / norm), 1e-10);
+}
