@@ -1,0 +1,50 @@
+// 2D Hertz (method.md §7): a Neo-Hookean disk (R = 5 mm, mu = 1.5 MPa, lambda = 3 MPa,
+// rho = 990 kg/m^3) squeezed quasi-statically between two rigid frictionless walls (bottom fixed,
+// top moving down at 0.3 m/s = 0.004 c_p), no gravity, theta = 1, 2x2 points per cell,
+// c_p dt / h = 0.25. The walls start on the extreme point domains (zero gaps), so the loss of
+// diameter is the top wall's travel. The load is the mean of the two wall forces. Acceptance:
+// within 10 % of Hertz for 0.02 <= Delta/D <= 0.05 at 20 and 40 cells per diameter, the error
+// shrinking under refinement. Long (about 4 minutes).
+#include <gtest/gtest.h>
+
+#include "../../support/contact_builders.hpp"
+
+using namespace mpmcd;
+using namespace mpmcd::test_support;
+
+namespace {
+SqueezeSetup hertz_setup(int cpd, grid::ShapeKind shape) {
+  SqueezeSetup su;
+  su.cells_per_diameter = cpd;
+  su.shape = shape;
+  su.wall_speed = 0.3;
+  su.courant = 0.25;
+  su.final_approach = 0.05 * 2 * su.radius;
+  su.samples = 20;
+  return su;
+}
+}  // namespace
+
+TEST(HertzLong, LinearShapesWithinTenPercentAt20And40CellsPerDiameter) {
+  std::vector<double> errs;
+  for (int cpd : {20, 40}) {
+    const auto su = hertz_setup(cpd, grid::ShapeKind::kLinear);
+    const auto r = run_squeeze(su);
+    ASSERT_TRUE(r.ok) << r.failure;
+    errs.push_back(print_hertz("linear", su, r, 0.02, 0.05));
+  }
+  std::printf(
+      "  Hertz error (max over 0.02 <= Delta/D <= 0.05): 20 cells/D %.3f, 40 cells/D %.3f,"
+      " ratio %.2f\n",
+      errs[0], errs[1], errs[0] / errs[1]);
+  EXPECT_LT(errs[0], 0.10);
+  EXPECT_LT(errs[1], 0.10);
+  EXPECT_LT(errs[1], errs[0]);
+}
+
+TEST(HertzLong, UGimpShapesWithinTenPercentAt20CellsPerDiameter) {
+  const auto su = hertz_setup(20, grid::ShapeKind::kUGimp);
+  const auto r = run_squeeze(su);
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_LT(print_hertz("ugimp", su, r, 0.02, 0.05), 0.10);
+}
