@@ -11,45 +11,95 @@
 namespace mpmcd::contact {
 
 template <int Dim>
-Vec<Dim> local_solution(const Vec<Dim>& u_free, double w, const Vec<Dim>& n, double gap_over_dt,
-                        double mu) {
-  // Signorini: p_n >= 0, u_n + g/dt >= 0, complementary; u = u_free + w P (method.md §4).
-  const double un = u_free.dot(n);
-  const double pn = -(un + gap_over_dt) / w;
-  if (!(pn > 0.0)) return Vec<Dim>::Zero();  // open
-  // Coulomb: stick (u_t = 0) inside the cone |p_t| <= mu p_n, else slide against u_t.
-  const Vec<Dim> ut = u_free - un * n;
-  const Vec<Dim> pt_stick = -ut / w;
-  const double pt_norm = pt_stick.norm();
-  if (pt_norm <= mu * pn) return pn * n + pt_stick;
-  return pn * n + (mu * pn / pt_norm) * pt_stick;
+Vec<Dim> local_solution(const Vec<Dim>& u_free, const Mat<Dim>& W, const Vec<Dim>& n,
+                        double gap_over_dt, double mu) {
+  // Signorini: p_n >= 0, u_n + g/dt >= 0, complementary; u = u_free + W P (method.md §4).
+  const double un0 = u_free.dot(n) + gap_over_dt;
+  if (!(un0 < 0.0)) return Vec<Dim>::Zero();  // open: no impulse needed
+  if constexpr (Dim == 2) {
+    // Frame (n, t): stick solves W' (p_n, p_t) = -(u_n + g/dt, u_t); slide puts p_t = -s mu p_n
+    // with s the sign of the resulting sliding velocity.
+    const Vec<2> t(-n[1], n[0]);
+    const double wnn = n.dot(W * n), wnt = n.dot(W * t), wtn = t.dot(W * n), wtt = t.dot(W * t);
+    const double uft = u_free.dot(t);
+    const double det = wnn * wtt - wnt * wtn;
+    const double pn_stick = (-un0 * wtt + uft * wnt) / det;
+    const double pt_stick = (-uft * wnn + un0 * wtn) / det;
+    if (pn_stick > 0.0 && std::abs(pt_stick) <= mu * pn_stick) return pn_stick * n + pt_stick * t;
+    for (double sgn : {1.0, -1.0}) {
+      const double pn = -un0 / (wnn - sgn * mu * wnt);
+      if (!(pn > 0.0)) continue;
+      const double ut = uft + wtn * pn - wtt * sgn * mu * pn;
+      if (sgn * ut >= 0.0) return pn * n - sgn * mu * pn * t;
+    }
+    return (-un0 / wnn) * n;  // degenerate W: frictionless normal impulse
+  } else {
+    // 3D: isotropic approximation w = tr(W)/3 (exact for lumped W = w I).
+    const double w = W.trace() / Dim;
+    const double pn = -un0 / w;
+    const Vec<Dim> ut = u_free - u_free.dot(n) * n;
+    const Vec<Dim> pt_stick = -ut / w;
+    const double pt_norm = pt_stick.norm();
+    if (pt_norm <= mu * pn) return pn * n + pt_stick;
+    return pn * n + (mu * pn / pt_norm) * pt_stick;
+  }
 }
 
 namespace {
+
+// Net impulse on each slot: sum of the impulses of the contacts where it is B, minus where it is A.
+template <int Dim>
+std::vector<Vec<Dim>> net_impulses(const Problem<Dim>& p) {
+  std::vector<Vec<Dim>> net(p.slots.size(), Vec<Dim>::Zero());
+  for (const auto& c : p.contacts) {
+    net[c.b] += c.impulse;
+    if (c.a >= 0) net[c.a] -= c.impulse;
+  }
+  return net;
+}
+
+// Diagonal response block W_ss of slot s: I/m (lumped) or its block of the group's G.
+template <int Dim>
+Mat<Dim> self_block(const Problem<Dim>& p, std::int32_t s) {
+  const Slot<Dim>& sl = p.slots[s];
+  if (sl.group < 0) return Mat<Dim>::Identity() / sl.mass;
+  return p.groups[sl.group].G.template block<Dim, Dim>(Dim * sl.local, Dim * sl.local);
+}
+
+// Adds the response to an impulse increment dP on slot s to the slot velocities v.
+template <int Dim>
+void respond(const Problem<Dim>& p, std::vector<Vec<Dim>>& v, std::int32_t s, const Vec<Dim>& dP) {
+  const Slot<Dim>& sl = p.slots[s];
+  if (sl.group < 0) {
+    v[s] += dP / sl.mass;
+    return;
+  }
+  const Group& g = p.groups[sl.group];
+  for (std::size_t j = 0; j < g.slots.size(); ++j)
+    v[g.slots[j]] += g.G.template block<Dim, Dim>(Dim * j, Dim * sl.local) * dP;
+}
 
 template <int Dim>
 std::vector<Vec<Dim>> slot_velocities(const Problem<Dim>& p) {
   std::vector<Vec<Dim>> v(p.slots.size());
   for (std::size_t s = 0; s < p.slots.size(); ++s) v[s] = p.slots[s].v_free;
-  for (const auto& c : p.contacts) {
-    v[c.b] += c.impulse / p.slots[c.b].mass;
-    if (c.a >= 0) v[c.a] -= c.impulse / p.slots[c.a].mass;
-  }
+  const auto net = net_impulses(p);
+  for (std::size_t s = 0; s < p.slots.size(); ++s)
+    if (net[s] != Vec<Dim>::Zero()) respond(p, v, static_cast<std::int32_t>(s), net[s]);
   return v;
 }
 
-// Relative free velocity of contact c (its own impulse removed) and its Delassus coefficient w.
+// Relative free velocity of contact c (its own impulse removed) and its Delassus block W.
 template <int Dim>
 void free_velocity(const Problem<Dim>& p, const std::vector<Vec<Dim>>& v, const Contact<Dim>& c,
-                   Vec<Dim>& u_free, double& w) {
-  const double mb = p.slots[c.b].mass;
-  const Vec<Dim> vb = v[c.b] - c.impulse / mb;
-  w = 1.0 / mb;
+                   Vec<Dim>& u_free, Mat<Dim>& W) {
+  W = self_block(p, c.b);
+  const Vec<Dim> vb = v[c.b] - W * c.impulse;
   Vec<Dim> va = c.wall_velocity;
   if (c.a >= 0) {
-    const double ma = p.slots[c.a].mass;
-    va = v[c.a] + c.impulse / ma;
-    w += 1.0 / ma;
+    const Mat<Dim> Wa = self_block(p, c.a);
+    va = v[c.a] + Wa * c.impulse;
+    W += Wa;
   }
   u_free = vb - va;
 }
@@ -62,9 +112,9 @@ double error(const Problem<Dim>& p) {
   double num = 0, den = 0;
   for (const auto& c : p.contacts) {
     Vec<Dim> u;
-    double w;
-    free_velocity(p, v, c, u, w);
-    const Vec<Dim> loc = local_solution<Dim>(u, w, c.normal, c.gap / p.dt, c.friction);
+    Mat<Dim> W;
+    free_velocity(p, v, c, u, W);
+    const Vec<Dim> loc = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
     num += (loc - c.impulse).squaredNorm();
     den += c.impulse.squaredNorm();
   }
@@ -84,12 +134,13 @@ GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings) {
   while (r.sweeps < settings.max_sweeps) {
     for (auto& c : p.contacts) {
       Vec<Dim> u;
-      double w;
-      free_velocity(p, v, c, u, w);
-      const Vec<Dim> P = local_solution<Dim>(u, w, c.normal, c.gap / p.dt, c.friction);
+      Mat<Dim> W;
+      free_velocity(p, v, c, u, W);
+      const Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
       const Vec<Dim> dP = P - c.impulse;
-      v[c.b] += dP / p.slots[c.b].mass;
-      if (c.a >= 0) v[c.a] -= dP / p.slots[c.a].mass;
+      if (dP == Vec<Dim>::Zero()) continue;
+      respond(p, v, c.b, dP);
+      if (c.a >= 0) respond(p, v, c.a, Vec<Dim>(-dP));
       c.impulse = P;
     }
     ++r.sweeps;
@@ -111,7 +162,7 @@ void write_problem(const Problem<Dim>& p, const std::string& path) {
   for (const auto& s : p.slots) {
     out << fmt::format("{:.17g}", s.mass);
     for (int d = 0; d < Dim; ++d) out << fmt::format(" {:.17g}", s.v_free[d]);
-    out << " " << s.grain << " " << s.node << "\n";
+    out << " " << s.grain << " " << s.node << " " << s.group << " " << s.local << "\n";
   }
   out << "contacts " << p.contacts.size() << "\n";
   for (const auto& c : p.contacts) {
@@ -121,6 +172,17 @@ void write_problem(const Problem<Dim>& p, const std::string& path) {
     out << fmt::format(" {:.17g} {:.17g}", c.gap, c.friction);
     for (int d = 0; d < Dim; ++d) out << fmt::format(" {:.17g}", c.impulse[d]);
     out << "\n";
+  }
+  out << "groups " << p.groups.size() << "\n";
+  for (const auto& g : p.groups) {
+    out << g.slots.size();
+    for (auto sl : g.slots) out << " " << sl;
+    out << "\n";
+    for (Eigen::Index i = 0; i < g.G.rows(); ++i) {
+      for (Eigen::Index j = 0; j < g.G.cols(); ++j)
+        out << fmt::format("{}{:.17g}", j ? " " : "", g.G(i, j));
+      out << "\n";
+    }
   }
 }
 
@@ -173,7 +235,7 @@ Problem<Dim> read_problem(const std::string& path) {
     auto ss = next("slot");
     ss >> s.mass;
     for (int d = 0; d < Dim; ++d) ss >> s.v_free[d];
-    ss >> s.grain >> s.node;
+    ss >> s.grain >> s.node >> s.group >> s.local;
     check(ss, "slot");
     if (!(s.mass > 0)) throw InputError(path, lineno, "slot", "expected a mass > 0");
   }
@@ -196,14 +258,43 @@ Problem<Dim> read_problem(const std::string& path) {
     if (c.b < 0 || c.b >= ns || c.a >= ns || c.a < -1)
       throw InputError(path, lineno, "contact", "slot index out of range");
   }
+  {
+    auto ss = next("groups");
+    expect(ss, "groups");
+    ss >> n;
+    check(ss, "groups");
+  }
+  p.groups.resize(n);
+  for (auto& g : p.groups) {
+    auto ss = next("group");
+    std::size_t k = 0;
+    ss >> k;
+    g.slots.resize(k);
+    for (auto& sl : g.slots) ss >> sl;
+    check(ss, "group");
+    for (auto sl : g.slots)
+      if (sl < 0 || sl >= static_cast<std::int32_t>(p.slots.size()))
+        throw InputError(path, lineno, "group", "slot index out of range");
+    g.G.resize(static_cast<Eigen::Index>(Dim * k), static_cast<Eigen::Index>(Dim * k));
+    for (Eigen::Index i = 0; i < g.G.rows(); ++i) {
+      auto row = next("group matrix");
+      for (Eigen::Index j = 0; j < g.G.cols(); ++j) row >> g.G(i, j);
+      check(row, "group matrix");
+    }
+  }
+  for (const auto& s : p.slots)
+    if (s.group >= static_cast<std::int32_t>(p.groups.size()) ||
+        (s.group >= 0 &&
+         (s.local < 0 || s.local >= static_cast<std::int32_t>(p.groups[s.group].slots.size()))))
+      throw InputError(path, 0, "slot", "group index out of range");
   return p;
 }
 
-#define MPMCD_INSTANTIATE(D)                                                               \
-  template Vec<D> local_solution<D>(const Vec<D>&, double, const Vec<D>&, double, double); \
-  template double error<D>(const Problem<D>&);                                             \
-  template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&);                 \
-  template void write_problem<D>(const Problem<D>&, const std::string&);                   \
+#define MPMCD_INSTANTIATE(D)                                                                      \
+  template Vec<D> local_solution<D>(const Vec<D>&, const Mat<D>&, const Vec<D>&, double, double); \
+  template double error<D>(const Problem<D>&);                                                    \
+  template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&);                        \
+  template void write_problem<D>(const Problem<D>&, const std::string&);                          \
   template Problem<D> read_problem<D>(const std::string&);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)

@@ -44,10 +44,15 @@ struct ImplicitSolver<Dim>::GrainWork {
   std::vector<Vec<Dim>> f_n, f_ext, f_int, f_abs, R, du;  // f_abs: sum of |V sigma g| (scale)
   std::vector<std::uint8_t> mask;                         // prescribed components
   std::vector<Vec<Dim>> P;       // contact impulse on each node over the step [N s]
-  std::vector<Vec<Dim>> grad_m;  // mass gradient sum m_p grad N_I(x_p) [kg/m]
+  std::vector<Vec<Dim>> grad_m;  // sum m_p grad N_I(x_p): outward mass gradient [kg/m]
   std::vector<Vec<Dim>> box_gm;  // scratch for grad_m on the box
   std::vector<std::int32_t> node_pts_start, node_pts;  // active node -> its points (CSR)
-  double contact_mass = 0;                // contact threshold: mass_fraction * a full cell's mass
+  double contact_mass = 0;
+  std::vector<std::int32_t> slots;  // contact slots of this grain (its compliance group)
+  Eigen::MatrixXd Z;                // A^-1 E: response of all dofs to unit slot impulses
+  bool tangent_current = false,
+       factor_current = false;            // K_blk / factorisation match v                // contact
+                                          // threshold: mass_fraction * a full cell's mass
   std::vector<IVec<Dim>> pt_first;        // per point: first support node (box coordinates)
   std::vector<std::int32_t> pt_node;      // per point x K: active node or -1
   std::vector<double> pt_N;               // per point x K: weights at x^n
@@ -349,6 +354,7 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
   const std::int64_t np = gr.size();
   const std::size_t na = w.m.size();
   const double theta = settings_.theta;
+  w.tangent_current = w.factor_current = false;
   // Nodal increment du_I = dt [(1 - theta) v_I^n + theta v_I^{n+1}] (method.md §2).
   for (std::size_t a = 0; a < na; ++a) w.du[a] = dt * ((1.0 - theta) * w.v_n[a] + theta * w.v[a]);
   // Kinematics: dF = I + sum du_I (x) grad N_I(x^n), F^{n+1} = dF F^n, V^{n+1} = J V^0.
@@ -432,13 +438,16 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
   const double rel = w.res_ref > 0 ? w.res_norm / w.res_ref : 0.0;
   w.history.push_back(rel);
   // Increment test in the mass norm |dv|_M = sqrt(sum m |dv|^2) against the velocity scale
-  // sqrt(sum m max(|v^{n+1}|^2, |v^n|^2)): nodes with a sliver of mass weigh accordingly.
-  double vref2 = 0;
-  for (std::size_t a = 0; a < na; ++a)
+  // sqrt(sum m max(|v^{n+1}|^2, |v^n|^2)) plus the velocity change the step's forces and impulses
+  // can produce, res_ref / sqrt(M) (a body at rest has no velocity scale of its own).
+  double vref2 = 0, mass = 0;
+  for (std::size_t a = 0; a < na; ++a) {
     vref2 += w.m[a] * std::max(w.v[a].squaredNorm(), w.v_n[a].squaredNorm());
+    mass += w.m[a];
+  }
+  const double vref = std::sqrt(vref2) + (mass > 0 ? w.res_ref / std::sqrt(mass) : 0.0);
   const bool res_ok = w.res_norm <= settings_.residual_tolerance * w.res_ref;
-  const bool inc_ok =
-      !w.solved_once || w.dv_norm <= settings_.increment_tolerance * std::sqrt(vref2);
+  const bool inc_ok = !w.solved_once || w.dv_norm <= settings_.increment_tolerance * vref;
   w.converged = res_ok && inc_ok;
   if (!w.converged) assemble_tangent<S1>(g);  // only needed when a solve follows
 }
@@ -486,10 +495,11 @@ void ImplicitSolver<Dim>::assemble_tangent(std::size_t g) {
       }
     }
   }
+  w.tangent_current = true;
 }
 
 template <int Dim>
-void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt) {
+bool ImplicitSolver<Dim>::factorize_grain(std::size_t g, double dt) {
   GrainWork& w = *work_[g];
   const std::size_t na = w.m.size();
   const double c = settings_.theta * settings_.theta * dt * dt;
@@ -512,30 +522,55 @@ void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt) {
           val[w.value_index[((a * w.S + s) * Dim + i) * Dim + j]] = v;
         }
     }
-  w.rhs.resize(static_cast<Eigen::Index>(na * Dim));
-  for (std::size_t a = 0; a < na; ++a)
-    for (int d = 0; d < Dim; ++d) w.rhs[a * Dim + d] = -w.R[a][d];
   bool ok = true;
   switch (settings_.linear_solver) {
     case LinearSolverKind::kLdlt:
       w.ldlt.factorize(w.A);
       ok = w.ldlt.info() == Eigen::Success;
-      if (ok) w.sol = w.ldlt.solve(w.rhs);
       break;
     case LinearSolverKind::kLu:
       w.lu.factorize(w.A);
       ok = w.lu.info() == Eigen::Success;
-      if (ok) w.sol = w.lu.solve(w.rhs);
       break;
     case LinearSolverKind::kCg:
       w.cg.setTolerance(settings_.cg_tolerance);
       w.cg.setMaxIterations(settings_.cg_max_iterations);
       w.cg.compute(w.A);
-      w.sol = w.cg.solve(w.rhs);
-      ok = w.cg.info() == Eigen::Success;
       break;
   }
-  if (!ok || !w.sol.allFinite()) {
+  if (!ok) w.failure = "linear solve failed (singular or indefinite tangent)";
+  w.factor_current = ok;
+  return ok;
+}
+
+template <int Dim>
+template <class Rhs>
+Eigen::VectorXd ImplicitSolver<Dim>::linear_solve(std::size_t g, const Rhs& rhs) {
+  GrainWork& w = *work_[g];
+  switch (settings_.linear_solver) {
+    case LinearSolverKind::kLdlt:
+      return w.ldlt.solve(rhs);
+    case LinearSolverKind::kLu:
+      return w.lu.solve(rhs);
+    case LinearSolverKind::kCg: {
+      Eigen::VectorXd x = w.cg.solve(rhs);
+      if (w.cg.info() != Eigen::Success) x.setConstant(std::numeric_limits<double>::quiet_NaN());
+      return x;
+    }
+  }
+  return {};
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt) {
+  GrainWork& w = *work_[g];
+  const std::size_t na = w.m.size();
+  if (!factorize_grain(g, dt)) return;
+  w.rhs.resize(static_cast<Eigen::Index>(na * Dim));
+  for (std::size_t a = 0; a < na; ++a)
+    for (int d = 0; d < Dim; ++d) w.rhs[a * Dim + d] = -w.R[a][d];
+  w.sol = linear_solve(g, w.rhs);
+  if (!w.sol.allFinite()) {
     w.failure = "linear solve failed (singular or indefinite tangent)";
     return;
   }
@@ -657,11 +692,16 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         break;
       }
     stats.failure =
-        fmt::format("Newton did not converge in {} iterations (relative residual {:.3e})",
+        fmt::format("Newton did not converge in {} iterations (relative residual {:.3e}",
                     settings_.max_iterations,
                     stats.residual_history.empty() ? 0.0 : stats.residual_history.back());
+    if (!problem_.contacts.empty())
+      stats.failure += fmt::format(", relative impulse change {:.3e}, Gauss-Seidel error {:.3e}",
+                                   impulse_change, stats.gs_error);
+    stats.failure += ")";
     return stats;
-  }  // Contact summary: active contacts and the force of the grains on each wall (-P/dt).
+  }
+  // Contact summary: active contacts and the force of the grains on each wall (-P/dt).
   stats.contacts = static_cast<std::int64_t>(problem_.contacts.size());
   stats.wall_force.assign(settings_.contact.walls.size(), {0.0, 0.0, 0.0});
   previous_.clear();
@@ -757,8 +797,10 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         if (A.g > B.g) std::swap(A, B);
         const GrainWork& wa = *work_[A.g];
         const GrainWork& wb = *work_[B.g];
-        // normal from A to B: n ∝ grad m^B - grad m^A (method.md §4)
-        Vec<Dim> normal = wb.grad_m[B.a] - wa.grad_m[A.a];
+        // Normal from A to B (method.md §4). g^X = sum_p m_p grad N_I(x_p) points OUT of grain X
+        // (grad N_I at a point points toward the node), i.e. it is minus the gradient of X's mass
+        // density, so n ∝ grad rho^B - grad rho^A = g^A - g^B.
+        Vec<Dim> normal = wa.grad_m[A.a] - wb.grad_m[B.a];
         const double len = normal.norm();
         if (!(len > 1e-12 * (wa.grad_m[A.a].norm() + wb.grad_m[B.a].norm()))) continue;
         normal /= len;
@@ -826,15 +868,84 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   for (std::size_t s = 0; s < slot_ref_.size(); ++s)
     work_[slot_ref_[s].first]->P[slot_ref_[s].second] = slot_p[s];
   gs_converged_ = true;
+  // Compliance groups: one per grain with contact slots when its linear solver is direct.
+  for (auto& w : work_) w->slots.clear();
+  problem_.groups.clear();
+  if (cs.grain_compliance && settings_.linear_solver != LinearSolverKind::kCg) {
+    for (std::size_t s = 0; s < slot_ref_.size(); ++s)
+      work_[slot_ref_[s].first]->slots.push_back(static_cast<std::int32_t>(s));
+    for (std::size_t g = 0; g < work_.size(); ++g) {
+      const auto& sl = work_[g]->slots;
+      if (sl.empty()) continue;
+      const auto gi = static_cast<std::int32_t>(problem_.groups.size());
+      contact::Group group;
+      group.slots = sl;
+      for (std::size_t j = 0; j < sl.size(); ++j) {
+        problem_.slots[sl[j]].group = gi;
+        problem_.slots[sl[j]].local = static_cast<std::int32_t>(j);
+      }
+      problem_.groups.push_back(std::move(group));
+    }
+  }
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
+  // Z = A^-1 E (response of the grain's velocities to unit impulses at its slots) and its slot
+  // rows G = E^T A^-1 E, from the factorisation of the current Newton matrix.
+  GrainWork& w = *work_[g];
+  if (!w.tangent_current) {
+    if (settings_.shape == grid::ShapeKind::kLinear)
+      assemble_tangent<grid::Linear1D>(g);
+    else
+      assemble_tangent<grid::UGimp1D>(g);
+  }
+  if (!w.factor_current && !factorize_grain(g, dt_)) return;
+  const auto k = static_cast<Eigen::Index>(w.slots.size());
+  const auto ndof = static_cast<Eigen::Index>(w.m.size() * Dim);
+  w.Z.setZero(ndof, Dim * k);
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(ndof);
+  for (Eigen::Index j = 0; j < k; ++j) {
+    const std::int32_t a = slot_ref_[w.slots[j]].second;
+    for (int d = 0; d < Dim; ++d) {
+      if (w.mask[a] & (1u << d)) continue;  // a prescribed component does not respond
+      e[a * Dim + d] = 1.0;
+      w.Z.col(Dim * j + d) = linear_solve(g, e);
+      e[a * Dim + d] = 0.0;
+    }
+  }
+  Eigen::MatrixXd& G = problem_.groups[problem_.slots[w.slots[0]].group].G;
+  G.resize(Dim * k, Dim * k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const std::int32_t a = slot_ref_[w.slots[i]].second;
+    G.middleRows(Dim * i, Dim) = w.Z.middleRows(a * Dim, Dim);
+  }
 }
 
 template <int Dim>
 double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
-  // Free velocities: the grains' current iterates without the contact impulses (lumped, §4).
+  // Response of each grain: its compliance group (exact, linearised) or the lumped 1/m_I.
+  const auto ngroups = static_cast<std::int64_t>(problem_.groups.size());
+#pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1)
+  for (std::int64_t gi = 0; gi < ngroups; ++gi)
+    grain_compliance(static_cast<std::size_t>(slot_ref_[problem_.groups[gi].slots[0]].first));
+  for (const auto& w : work_)
+    if (!w->failure.empty()) return 1.0;
+  // Free velocities: the grains' current iterates without their contact impulses (method.md §4).
   for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
     const GrainWork& w = *work_[slot_ref_[s].first];
     const std::int32_t a = slot_ref_[s].second;
-    problem_.slots[s].v_free = w.v[a] - w.P[a] / w.m[a];
+    auto& slot = problem_.slots[s];
+    slot.mass = w.m[a];
+    if (slot.group < 0) {
+      slot.v_free = w.v[a] - w.P[a] / w.m[a];
+    } else {
+      const auto& group = problem_.groups[slot.group];
+      slot.v_free = w.v[a];
+      for (std::size_t j = 0; j < group.slots.size(); ++j)
+        slot.v_free -= group.G.template block<Dim, Dim>(Dim * slot.local, Dim * j) *
+                       w.P[slot_ref_[group.slots[j]].second];
+    }
   }
   std::vector<Vec<Dim>> old(problem_.contacts.size());
   for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
@@ -851,18 +962,40 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     slot_p[ct.b] += ct.impulse;
     if (ct.a >= 0) slot_p[ct.a] -= ct.impulse;
   }
-  // The impulses enter the grains' residuals; their nodes move with the lumped update
-  // v = v_free + P/m, and a grain whose impulses changed is iterated again.
+  // The new impulses enter the grains' residuals; their velocities take the linearised response
+  // (v += Z dP, or the lumped v = v_free + P/m), and a grain whose impulses changed iterates again.
   std::vector<double> dv2(work_.size(), -1.0);
   for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
     GrainWork& w = *work_[slot_ref_[s].first];
     const std::int32_t a = slot_ref_[s].second;
-    if (slot_p[s] == w.P[a]) continue;
+    if (slot_p[s] == w.P[a] || problem_.slots[s].group >= 0) continue;
     w.P[a] = slot_p[s];
     const Vec<Dim> v_new = problem_.slots[s].v_free + slot_p[s] / w.m[a];
     double& acc = dv2[slot_ref_[s].first];
     acc = std::max(acc, 0.0) + w.m[a] * (v_new - w.v[a]).squaredNorm();
     w.v[a] = v_new;
+  }
+  for (const auto& group : problem_.groups) {
+    const std::int32_t g = slot_ref_[group.slots[0]].first;
+    GrainWork& w = *work_[g];
+    Eigen::VectorXd dP(Dim * static_cast<Eigen::Index>(group.slots.size()));
+    bool changed = false;
+    for (std::size_t j = 0; j < group.slots.size(); ++j) {
+      const std::int32_t a = slot_ref_[group.slots[j]].second;
+      const Vec<Dim> d = slot_p[group.slots[j]] - w.P[a];
+      changed = changed || d != Vec<Dim>::Zero();
+      dP.template segment<Dim>(Dim * static_cast<Eigen::Index>(j)) = d;
+      w.P[a] = slot_p[group.slots[j]];
+    }
+    if (!changed) continue;
+    const Eigen::VectorXd dv = w.Z * dP;
+    double acc = 0;
+    for (std::size_t a = 0; a < w.m.size(); ++a) {
+      const Vec<Dim> d = dv.template segment<Dim>(static_cast<Eigen::Index>(a * Dim));
+      w.v[a] += d;
+      acc += w.m[a] * d.squaredNorm();
+    }
+    dv2[g] = acc;
   }
   for (std::size_t g = 0; g < work_.size(); ++g)
     if (dv2[g] >= 0.0) {

@@ -17,6 +17,16 @@ struct Slot {
   Vec<Dim> v_free = Vec<Dim>::Zero();  ///< end-of-step velocity without contact impulses [m/s]
   std::int32_t grain = -1;             ///< grain owning the field (information only)
   std::int64_t node = -1;              ///< global grid node (information only)
+  std::int32_t group = -1;             ///< compliance group (-1: lumped response P / mass)
+  std::int32_t local = -1;             ///< index of the slot in its group
+};
+
+/// The linearised response of one grain at its contact slots: the velocity of slot i changes by
+/// sum_j G_ij P_j for net impulses P_j on the group's slots (G = E^T A^-1 E, A the grain's Newton
+/// matrix; the "stiffness-corrected" Delassus operator of method.md §4).
+struct Group {
+  std::vector<std::int32_t> slots;  ///< slots of the group, in local order
+  Eigen::MatrixXd G;                ///< (Dim n) x (Dim n) compliance [s/kg]
 };
 
 /// One contact between slot A (or a wall, a = -1) and slot B; the impulse acts on B, its opposite
@@ -39,6 +49,7 @@ struct Problem {
   double dt = 0;                       ///< time step [s]
   std::vector<Slot<Dim>> slots;        ///< nodes taking part
   std::vector<Contact<Dim>> contacts;  ///< contacts (their impulses are the unknowns)
+  std::vector<Group> groups;           ///< compliance groups (empty: all slots lumped)
 };
 
 /// Gauss-Seidel settings.
@@ -54,13 +65,20 @@ struct GsResult {
   bool converged = false;  ///< error <= tolerance
 };
 
-/// Exact solution of one contact's local problem u = u_free + w P (lumped Delassus W = w I):
-/// open if the trial normal impulse -(u_free.n + g/dt)/w is negative, else stick if the stick
-/// impulse lies in the Coulomb cone |p_t| <= mu p_n, else slide with p_t = -mu p_n u_t/|u_t|
-/// (method.md §4).
+/// Exact solution of one contact's local problem u = u_free + W P with an SPD Delassus block W:
+/// open if u_free.n + g/dt >= 0 without impulse, else stick (u_t = 0, u_n + g/dt = 0) if its
+/// impulse lies in the Coulomb cone |p_t| <= mu p_n, else slide on the cone against the sliding
+/// velocity (method.md §4). Exact in 2D for any W; in 3D exact for isotropic W = w I.
+template <int Dim>
+Vec<Dim> local_solution(const Vec<Dim>& u_free, const Mat<Dim>& W, const Vec<Dim>& n,
+                        double gap_over_dt, double mu);
+
+/// Lumped form W = w I of local_solution.
 template <int Dim>
 Vec<Dim> local_solution(const Vec<Dim>& u_free, double w, const Vec<Dim>& n, double gap_over_dt,
-                        double mu);
+                        double mu) {
+  return local_solution<Dim>(u_free, Mat<Dim>(w * Mat<Dim>::Identity()), n, gap_over_dt, mu);
+}
 
 /// Error measure shared by the solver and the tests: with the slot velocities implied by the
 /// current impulses, sqrt(sum_c |P_c - local_c(P)|^2) / sqrt(sum_c |P_c|^2), where local_c is the

@@ -90,8 +90,8 @@ struct TimeSection {
 /// [solver]: Newton-Raphson and linear solver settings.
 struct SolverSection {
   int max_iterations = 25;             ///< Newton iterations before the step is declared failed [-]
-  double residual_tolerance = 1e-10;   ///< relative residual tolerance [-]
-  double increment_tolerance = 1e-10;  ///< relative velocity-increment tolerance [-]
+  double residual_tolerance = 1e-8;    ///< relative residual tolerance (floor ~1e-10: F near I) [-]
+  double increment_tolerance = 1e-8;   ///< relative velocity-increment tolerance [-]
   std::string linear_solver = "ldlt";  ///< "ldlt" (sparse direct), "lu" or "cg" (Jacobi CG)
   double cg_tolerance = 1e-12;         ///< relative residual of the CG solve [-]
   int cg_max_iterations = 1000;        ///< CG iteration limit [-]
