@@ -806,19 +806,26 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         normal /= len;
         double gap = 0;
         if (cs.criterion == GapCriterion::kGap) {
-          // gap between the extreme point surfaces of A and B along n near the node
+          // Gap near the node: the smallest distance between a point domain of A and one of B
+          // in the node's support, |x_q - x_p| minus both domains' extents along x_q - x_p
+          // (a projection on the node's normal underestimates it where the normal is tilted).
           const double lpa = grains_[A.g].half_width, lpb = grains_[B.g].half_width;
-          double sa = -std::numeric_limits<double>::infinity();
-          double sb = std::numeric_limits<double>::infinity();
+          gap = std::numeric_limits<double>::infinity();
           for (std::int32_t k = wa.node_pts_start[A.a]; k < wa.node_pts_start[A.a + 1]; ++k) {
             const std::int64_t p = grains_[A.g].begin + wa.node_pts[k];
-            sa = std::max(sa, points_.x[p].dot(normal) + extent(p, lpa, normal));
+            for (std::int32_t l = wb.node_pts_start[B.a]; l < wb.node_pts_start[B.a + 1]; ++l) {
+              const std::int64_t q = grains_[B.g].begin + wb.node_pts[l];
+              const Vec<Dim> d = points_.x[q] - points_.x[p];
+              const double len_d = d.norm();
+              if (!(len_d > 0)) {
+                gap = 0;
+                continue;
+              }
+              const Vec<Dim> e = d / len_d;
+              gap = std::min(gap, len_d - extent(p, lpa, e) - extent(q, lpb, e));
+            }
           }
-          for (std::int32_t k = wb.node_pts_start[B.a]; k < wb.node_pts_start[B.a + 1]; ++k) {
-            const std::int64_t p = grains_[B.g].begin + wb.node_pts[k];
-            sb = std::min(sb, points_.x[p].dot(normal) - extent(p, lpb, normal));
-          }
-          gap = std::max(0.0, sb - sa);
+          gap = std::max(0.0, gap);
         }
         contact::Contact<Dim> c;
         c.a = slot_of(A.g, A.a);
@@ -845,6 +852,9 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
           gap = std::min(gap, wall.distance(points_.x[p], time_) - extent(p, lp, wall.normal));
         }
         if (!std::isfinite(gap)) continue;
+        // A node inside the grain may approach the wall by its own distance at least: only the
+        // nodes at or beyond the material surface are held by the wall (no rigid boundary layer).
+        gap = std::max(gap, wall.distance(xn, time_));
         contact::Contact<Dim> c;
         c.a = -1;
         c.wall = static_cast<std::int32_t>(wi);

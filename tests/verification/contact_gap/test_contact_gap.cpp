@@ -5,11 +5,7 @@
 // curves are written to a CSV file (docs/figures/contact_gap.png is drawn from it by
 // tools/plot_contact_gap.py).
 //
-// DISABLED: the engine's grain-grain normal points from B to A (src/mpm/solver.cpp,
-// detect_contacts: n = grad_m^B - grad_m^A with grad_m = sum m_p grad N_I(x_p), which is each
-// body's outward direction), so approaching grains look separating and get no impulse until they
-// overlap by about 2.5 cells. Repro: ContactGap.DISABLED_HeadOnNormalPointsFromAToB. Enable both
-// tests once the normal is fixed (run now with --gtest_also_run_disabled_tests).
+// HeadOnNormalPointsFromAToB guards the normal direction (it once pointed from B to A).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -119,7 +115,7 @@ Approach approach(mpm::GapCriterion criterion, grid::ShapeKind shape, int cpd = 
 
 }  // namespace
 
-TEST(ContactGap, DISABLED_FirstForceDistancePerCriterion) {
+TEST(ContactGap, FirstForceDistancePerCriterion) {
   const std::string csv =
       (std::filesystem::temp_directory_path() / "mpmcd_contact_gap.csv").string();
   std::ofstream f(csv);
@@ -137,14 +133,14 @@ TEST(ContactGap, DISABLED_FirstForceDistancePerCriterion) {
             << sm.active << '\n';
         ASSERT_GT(a.first_distance, 0) << "no contact force";
         const double early = (a.first_distance - a.diameter) / a.h;
-        // kGap: the force must appear when the point domains meet; the centre distance is exact
-        // (rigid translation) and one step closes 0.01 h, so +-0.25 h is the error of the gap
-        // estimate itself (normals tilted off the line of centres, domain extents along n).
-        // kOverlap: the supports share a node about a cell before the materials meet.
+        // kGap: the force must appear when the point domains meet (measured: within 0.002 h at
+        // 10 and 20 cells per diameter, one step closing 0.01 h). kOverlap: the supports share a
+        // node before the materials meet (measured: 0.48 h early with linear shape functions,
+        // 0.90 h with uGIMP, whose support is wider).
         if (crit == mpm::GapCriterion::kGap) {
-          EXPECT_LT(std::abs(early), 0.25) << name_of(shape) << " D/h = " << cpd;
+          EXPECT_LT(std::abs(early), 0.05) << name_of(shape) << " D/h = " << cpd;
         } else {
-          EXPECT_GT(early, 0.5) << name_of(shape) << " D/h = " << cpd;
+          EXPECT_GT(early, 0.4) << name_of(shape) << " D/h = " << cpd;
         }
         std::printf("  %-8s %-7s %4d %14.3f %16.5f %14.3f\n", name_of(crit), name_of(shape), cpd,
                     early, a.first_distance / a.diameter, a.first_gap / a.h);
@@ -157,7 +153,7 @@ TEST(ContactGap, DISABLED_FirstForceDistancePerCriterion) {
 // Minimal reproduction of the normal-direction bug: disk A (left) and B (right) half a cell apart,
 // closing at 2 m/s, support-overlap criterion: the shared nodes' normals should point from A to B
 // (+x) and the approaching disks get a positive impulse.
-TEST(ContactGap, DISABLED_HeadOnNormalPointsFromAToB) {
+TEST(ContactGap, HeadOnNormalPointsFromAToB) {
   auto model = make_model(1e-3, 30, 16, "neo_hookean", kLambda, kMu, kRho);
   test_support::add_disk(model, Vec<2>(0.009, 0.008), 5e-3, 2,
                          [](const Vec<2>&) { return Vec<2>(1.0, 0); });
