@@ -180,6 +180,15 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
   c.gs.max_sweeps = cfg.contact.max_sweeps;
   c.impulse_tolerance = cfg.contact.impulse_tolerance;
   c.wall_range = cfg.contact.wall_range;
+  // Delassus operator: the lumped 1/m_I is accurate when inertia dominates a step (theta c_p dt/h
+  // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered
+  // contact-Newton loop converging in a few iterations.
+  double cp = 0;
+  for (const auto& m : cfg.materials)
+    cp = std::max(cp, std::sqrt((m.params.at("lambda") + 2 * m.params.at("mu")) / m.density));
+  const double courant = cfg.time.theta * cp * cfg.time.dt / cfg.grid.cell_size;
+  c.grain_compliance =
+      cfg.contact.delassus == "grain" || (cfg.contact.delassus == "auto" && courant > 0.1);
   const auto nm = static_cast<int>(cfg.materials.size());
   c.materials = nm;
   c.friction.assign(static_cast<std::size_t>(nm * nm), cfg.contact.friction);

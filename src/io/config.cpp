@@ -315,6 +315,12 @@ Schema build_schema() {
             .greater_than(0.0)
             .at_most(3.0)
             .defaults(num(d.contact.wall_range)),
+        KeySpec::string("delassus",
+                        "contact compliance: \"grain\" (each grain's exact linearised response "
+                        "from its factorised Newton matrix; direct solvers), \"lumped\" (1/m_I), "
+                        "or \"auto\" (grain when theta c_p dt / h > 0.1 and the solver is direct)")
+            .one_of({"auto", "grain", "lumped"})
+            .defaults(str(d.contact.delassus)),
         KeySpec::table_array("pairs", "contact.pairs[]", "friction per pair of materials")
             .defaults("none")},
        ""});
@@ -682,6 +688,7 @@ class ConfigReader {
     r.read("max_sweeps", k.max_sweeps);
     r.read("impulse_tolerance", k.impulse_tolerance);
     r.read("wall_range", k.wall_range);
+    r.read("delassus", k.delassus);
     const auto tables = r.table_array("pairs");
     for (std::size_t i = 0; i < tables.size(); ++i) {
       const toml::table& t = *tables[i];

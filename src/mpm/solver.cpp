@@ -47,12 +47,12 @@ struct ImplicitSolver<Dim>::GrainWork {
   std::vector<Vec<Dim>> grad_m;  // sum m_p grad N_I(x_p): outward mass gradient [kg/m]
   std::vector<Vec<Dim>> box_gm;  // scratch for grad_m on the box
   std::vector<std::int32_t> node_pts_start, node_pts;  // active node -> its points (CSR)
-  double contact_mass = 0;
+  double contact_mass = 0;          // contact threshold: mass_fraction * a full cell's mass
   std::vector<std::int32_t> slots;  // contact slots of this grain (its compliance group)
   Eigen::MatrixXd Z;                // A^-1 E: response of all dofs to unit slot impulses
-  bool tangent_current = false,
-       factor_current = false;            // K_blk / factorisation match v                // contact
-                                          // threshold: mass_fraction * a full cell's mass
+  bool tangent_current = false, factor_current = false;  // K_blk / factorisation match v
+  double vel_ref = 0;                     // velocity scale of the increment test [sqrt(kg) m/s]
+  bool evaluated = false;                 // residual evaluated in the current Newton iteration
   std::vector<IVec<Dim>> pt_first;        // per point: first support node (box coordinates)
   std::vector<std::int32_t> pt_node;      // per point x K: active node or -1
   std::vector<double> pt_N;               // per point x K: weights at x^n
@@ -435,21 +435,16 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
     w.failure = "non-finite residual";
     return;
   }
-  const double rel = w.res_ref > 0 ? w.res_norm / w.res_ref : 0.0;
-  w.history.push_back(rel);
-  // Increment test in the mass norm |dv|_M = sqrt(sum m |dv|^2) against the velocity scale
-  // sqrt(sum m max(|v^{n+1}|^2, |v^n|^2)) plus the velocity change the step's forces and impulses
-  // can produce, res_ref / sqrt(M) (a body at rest has no velocity scale of its own).
+  // Velocity scale of the increment test (mass norm): sqrt(sum m max(|v^{n+1}|^2, |v^n|^2)) plus
+  // the velocity change the step's forces and impulses can produce, res_ref / sqrt(M) (a body at
+  // rest has no velocity scale of its own). The convergence decision is taken in solve_step.
   double vref2 = 0, mass = 0;
   for (std::size_t a = 0; a < na; ++a) {
     vref2 += w.m[a] * std::max(w.v[a].squaredNorm(), w.v_n[a].squaredNorm());
     mass += w.m[a];
   }
-  const double vref = std::sqrt(vref2) + (mass > 0 ? w.res_ref / std::sqrt(mass) : 0.0);
-  const bool res_ok = w.res_norm <= settings_.residual_tolerance * w.res_ref;
-  const bool inc_ok = !w.solved_once || w.dv_norm <= settings_.increment_tolerance * vref;
-  w.converged = res_ok && inc_ok;
-  if (!w.converged) assemble_tangent<S1>(g);  // only needed when a solve follows
+  w.vel_ref = std::sqrt(vref2) + (mass > 0 ? w.res_ref / std::sqrt(mass) : 0.0);
+  w.evaluated = true;
 }
 
 template <int Dim>
@@ -634,7 +629,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     problem_.contacts.clear();
     problem_.slots.clear();
   }
-  double impulse_change = 0;
+  double impulse_change = 0, ref_scale = 0, vel_scale = 0;
   for (int it = 0; it <= settings_.max_iterations; ++it) {
     {
       ScopedStage t(&timers_, "newton.assemble");
@@ -650,12 +645,30 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       }
     }
     if (collect_failure()) return stats;
+    // Convergence of each evaluated grain: |R| <= tol * reference and |dv|_M <= tol * velocity
+    // scale, the references floored at 1e-3 of the largest grain's so that a grain at rest (whose
+    // own scales vanish) is judged on the scale of the step, not on round-off.
+    for (std::size_t g = 0; g < ng; ++g) {
+      if (!work_[g]->evaluated) continue;
+      ref_scale = std::max(ref_scale, work_[g]->res_ref);
+      vel_scale = std::max(vel_scale, work_[g]->vel_ref);
+    }
     double worst = 0;
     bool all = true;
     for (std::size_t g = 0; g < ng; ++g) {
-      if (!work_[g]->history.empty() && static_cast<int>(work_[g]->history.size()) == it + 1)
-        worst = std::max(worst, work_[g]->history.back());
-      all = all && work_[g]->converged;
+      GrainWork& w = *work_[g];
+      if (w.evaluated) {
+        w.evaluated = false;
+        const double ref = std::max(w.res_ref, 1e-3 * ref_scale);
+        const double vref = std::max(w.vel_ref, 1e-3 * vel_scale);
+        const bool res_ok = w.res_norm <= settings_.residual_tolerance * ref;
+        const bool inc_ok = !w.solved_once || w.dv_norm <= settings_.increment_tolerance * vref;
+        w.converged = res_ok && inc_ok;
+        const double rel = ref > 0 ? w.res_norm / ref : 0.0;
+        w.history.push_back(rel);
+        worst = std::max(worst, rel);
+      }
+      all = all && w.converged;
     }
     stats.residual_history.push_back(worst);
     // Staggered with Newton: the step has converged when the grains have (with the current
@@ -672,7 +685,14 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
 #pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
       for (std::size_t g = 0; g < ng; ++g) {
         GrainWork& w = *work_[g];
-        if (!w.converged && w.failure.empty()) solve_grain(g, dt);
+        if (w.converged || !w.failure.empty()) continue;
+        if (!w.tangent_current) {
+          if (linear)
+            assemble_tangent<grid::Linear1D>(g);
+          else
+            assemble_tangent<grid::UGimp1D>(g);
+        }
+        solve_grain(g, dt);
       }
     }
     if (collect_failure()) return stats;
@@ -959,7 +979,11 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   }
   std::vector<Vec<Dim>> old(problem_.contacts.size());
   for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
-  const contact::GsResult r = contact::solve_gauss_seidel(problem_, settings_.contact.gs);
+  contact::GsResult r;
+  {
+    ScopedStage t(&timers_, "contact.gs");
+    r = contact::solve_gauss_seidel(problem_, settings_.contact.gs);
+  }
   stats.gs_sweeps += r.sweeps;
   stats.gs_error = r.error;
   gs_converged_ = r.converged;

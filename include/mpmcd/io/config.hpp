@@ -115,6 +115,7 @@ struct ContactSection {
   int max_sweeps = 1000;          ///< Gauss-Seidel sweep limit [-]
   double impulse_tolerance = 1e-6;  ///< relative impulse change between Newton iterations [-]
   double wall_range = 1.0;          ///< grain nodes within this many cells of a wall take part [-]
+  std::string delassus = "auto";    ///< "grain" (exact grain compliance), "lumped" or "auto"
   std::vector<ContactPairSection> pairs;  ///< per material-pair friction
 };
 
