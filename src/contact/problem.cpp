@@ -223,14 +223,17 @@ Problem<Dim> read_problem(const std::string& path) {
     check(ss, "dt");
     if (!(p.dt > 0)) throw InputError(path, lineno, "dt", "expected dt > 0");
   }
-  std::size_t n = 0;
-  {
-    auto ss = next("slots");
-    expect(ss, "slots");
+  // "<key> <count>" lines; a count beyond 1e8 is a corrupt file, not a problem to allocate.
+  const auto count = [&](const char* key) {
+    auto ss = next(key);
+    expect(ss, key);
+    std::size_t n = 0;
     ss >> n;
-    check(ss, "slots");
-  }
-  p.slots.resize(n);
+    check(ss, key);
+    if (n > 100000000) throw InputError(path, lineno, key, "count above 1e8: corrupt file");
+    return n;
+  };
+  p.slots.resize(count("slots"));
   for (auto& s : p.slots) {
     auto ss = next("slot");
     ss >> s.mass;
@@ -239,13 +242,7 @@ Problem<Dim> read_problem(const std::string& path) {
     check(ss, "slot");
     if (!(s.mass > 0)) throw InputError(path, lineno, "slot", "expected a mass > 0");
   }
-  {
-    auto ss = next("contacts");
-    expect(ss, "contacts");
-    ss >> n;
-    check(ss, "contacts");
-  }
-  p.contacts.resize(n);
+  p.contacts.resize(count("contacts"));
   for (auto& c : p.contacts) {
     auto ss = next("contact");
     ss >> c.a >> c.b >> c.wall;
@@ -258,17 +255,13 @@ Problem<Dim> read_problem(const std::string& path) {
     if (c.b < 0 || c.b >= ns || c.a >= ns || c.a < -1)
       throw InputError(path, lineno, "contact", "slot index out of range");
   }
-  {
-    auto ss = next("groups");
-    expect(ss, "groups");
-    ss >> n;
-    check(ss, "groups");
-  }
-  p.groups.resize(n);
+  p.groups.resize(count("groups"));
   for (auto& g : p.groups) {
     auto ss = next("group");
     std::size_t k = 0;
     ss >> k;
+    if (k > p.slots.size())
+      throw InputError(path, lineno, "group", "more slots than the problem has");
     g.slots.resize(k);
     for (auto& sl : g.slots) ss >> sl;
     check(ss, "group");

@@ -2,9 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 #include "mpmcd/contact/problem.hpp"
+#include "mpmcd/core/errors.hpp"
 
 using namespace mpmcd;
 using contact::local_solution;
@@ -94,4 +96,29 @@ TEST(GaussSeidel, ReplayedProblemGivesTheSameImpulses) {
     norm += p.contacts[c].impulse.squaredNorm();
   }
   EXPECT_LE(std::sqrt(diff / norm), 1e-10);
+}
+
+TEST(ProblemFile, CorruptFilesAreRefusedWithAClearError) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"", "unexpected end of file"},
+      {"dim 3\n", "expected 2"},
+      {"dim 2\ndt -1\n", "dt > 0"},
+      {"dim 2\ndt 1e-3\nslots 999999999999\n", "corrupt file"},
+      {"dim 2\ndt 1e-3\nslots 1\n1.0 x 0 0 0 -1 -1\n", "malformed numbers"},
+      {"dim 2\ndt 1e-3\nslots 1\n1.0 0 0 0 0 -1 -1\ncontacts 1\n-1 5 0 0 1 0 0 0 0 0 0\n",
+       "slot index out of range"},
+      {"dim 2\ndt 1e-3\nslots 1\n1.0 0 0 0 0 -1 -1\ncontacts 0\n", "unexpected end of file"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const auto path = (dir / ("mpmcd_bad_problem_" + std::to_string(i) + ".txt")).string();
+    std::ofstream(path) << cases[i].first;
+    try {
+      contact::read_problem<2>(path);
+      ADD_FAILURE() << "case " << i << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(cases[i].second), std::string::npos)
+          << "case " << i << ": " << e.what();
+    }
+  }
 }
