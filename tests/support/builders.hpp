@@ -9,6 +9,11 @@
 
 namespace mpmcd::test_support {
 
+// The paper's gel (method.md §3, lambda = 3 MPa): Lame coefficients [Pa], density [kg/m^3] and
+// P-wave speed c_p = sqrt((lambda + 2 mu) / rho) [m/s], shared by the verification tests.
+inline constexpr double kLambda = 3e6, kMu = 1.5e6, kRho = 990.0;
+inline const double kCp = std::sqrt((kLambda + 2 * kMu) / kRho);
+
 // A 2D model on a grid [0, cells*h]^2 with one material of the given law.
 inline mpm::Model<2> make_model(double h, int cells_x, int cells_y, const std::string& law,
                                 double lambda, double mu, double rho) {

@@ -13,12 +13,13 @@
 using namespace mpmcd;
 using test_support::add_box;
 using test_support::add_disk;
+using test_support::kCp;
+using test_support::kLambda;
+using test_support::kMu;
+using test_support::kRho;
 using test_support::make_model;
 
 namespace {
-
-constexpr double kLambda = 3e6, kMu = 1.5e6, kRho = 990.0;
-const double kCp = std::sqrt((kLambda + 2 * kMu) / kRho);
 
 mpm::Settings<2> contact_settings(std::vector<mpm::Wall<2>> walls, double friction = 0.0) {
   mpm::Settings<2> s;

@@ -11,12 +11,13 @@
 using namespace mpmcd;
 using test_support::add_box;
 using test_support::add_disk;
+using test_support::kCp;
+using test_support::kLambda;
+using test_support::kMu;
+using test_support::kRho;
 using test_support::make_model;
 
 namespace {
-
-constexpr double kLambda = 3e6, kMu = 1.5e6, kRho = 990.0;
-const double kCp = std::sqrt((kLambda + 2 * kMu) / kRho);
 
 struct BarResult {
   double period = 0;  // measured first period [s]

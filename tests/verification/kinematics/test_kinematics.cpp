@@ -11,11 +11,13 @@
 using namespace mpmcd;
 using test_support::add_box;
 using test_support::add_disk;
+using test_support::kCp;
+using test_support::kLambda;
+using test_support::kMu;
+using test_support::kRho;
 using test_support::make_model;
 
 namespace {
-
-constexpr double kLambda = 3e6, kMu = 1.5e6, kRho = 990.0;
 
 // Drives every node with du = (dF - I)(x - c) per step (theta = 1, so v = du / dt), n steps.
 void drive(mpm::Model<2>& model, grid::ShapeKind shape, const Mat<2>& dF, const Vec<2>& c,
