@@ -67,6 +67,23 @@ void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t
                                    "inside the grid with one cell of margin (grains[{}], {}:{})",
                                    d.x, d.y, d.radius, index, cfg.source_path, g.line));
   }
+  if (g.seeding == "polar") {  // each disk on its own rings, strictly inside its circle
+    const double s = h / g.points_per_cell;
+    double estimate = 0;
+    for (const auto& d : pk.disks) estimate += std::numbers::pi * d.radius * d.radius / (s * s);
+    if (estimate > 2e8)
+      throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].points_per_cell", index),
+                       fmt::format("the packing would need about {:.3g} material points (at most "
+                                   "2e8): coarsen the grid or lower points_per_cell",
+                                   estimate));
+    for (const auto& d : pk.disks) {
+      const Vec<2> c(d.x, d.y);
+      model.add_grain(points::seed_disk_polar(c, d.radius, h / g.points_per_cell), material,
+                      0.5 * h / g.points_per_cell,
+                      [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
+    }
+    return;
+  }
   const auto seeded = packing::seed_packing(pk, model.grid.origin(), h, g.points_per_cell);
   for (std::size_t k = 0; k < pk.disks.size(); ++k) {
     points::Seeds<2> seeds;
@@ -104,7 +121,10 @@ mpm::Model<2> build_model(const io::Config& cfg) {
     Vec<2> center;
     if (g.shape == "disk") {
       center = vec2(g.center);
-      seeds = points::seed_ball<2>(model.grid.origin(), h, g.points_per_cell, center, g.radius);
+      seeds =
+          g.seeding == "polar"
+              ? points::seed_disk_polar(center, g.radius, h / g.points_per_cell)
+              : points::seed_ball<2>(model.grid.origin(), h, g.points_per_cell, center, g.radius);
     } else if (g.shape == "rectangle") {
       const Vec<2> lo = vec2(g.min_corner), hi = vec2(g.max_corner);
       center = 0.5 * (lo + hi);

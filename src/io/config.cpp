@@ -170,6 +170,12 @@ Schema build_schema() {
             .at_least(1)
             .at_most(8)
             .defaults(num(dg.points_per_cell)),
+        KeySpec::string("seeding",
+                        "where the points go: `lattice` (grid-aligned sites, spacing h / "
+                        "points_per_cell) or `polar` (disks only: concentric rings of that "
+                        "spacing, outermost point domains tangent to the circle, docs/contact.md)")
+            .one_of({"lattice", "polar"})
+            .defaults("polar for disk and packing, lattice for rectangle"),
         KeySpec::subtable("initial", "grains[].initial", "initial velocity field")
             .defaults("at rest")},
        ""});
@@ -514,6 +520,10 @@ class ConfigReader {
       r.read("max_corner", g.max_corner);
       r.read("file", g.file);
       r.read("points_per_cell", g.points_per_cell);
+      r.read("seeding", g.seeding);
+      if (g.seeding.empty()) g.seeding = g.shape == "rectangle" ? "lattice" : "polar";
+      if (g.shape == "rectangle" && g.seeding == "polar")
+        r.fail("seeding", "polar seeding is for disks and packings, not for shape \"rectangle\"");
       if (std::find(names.begin(), names.end(), g.material) == names.end()) {
         std::string msg =
             fmt::format("unknown material \"{}\", defined: {}", g.material, fmt::join(names, ", "));

@@ -1,5 +1,6 @@
 #include "mpmcd/points/seeding.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -69,6 +70,34 @@ Seeds<Dim> seed_box(const Vec<Dim>& origin, double h, int ppc, const Vec<Dim>& l
     if (((x - lo).array() > 0).all() && ((hi - x).array() > 0).all()) seeds.x.push_back(x);
   });
   scale_volumes(seeds, s, (hi - lo).prod());
+  return seeds;
+}
+
+Seeds<2> seed_disk_polar(const Vec<2>& center, double radius, double spacing) {
+  Seeds<2> seeds;
+  if (!(radius > 0) || !(spacing > 0)) return seeds;
+  const int n = std::max(1, static_cast<int>(std::lround(radius / spacing - 0.5)));
+  const double dr = radius / (n + 0.5);
+  // Central point: the disk of radius dr/2, as a square of the same area.
+  seeds.x.push_back(center);
+  seeds.volume.push_back(std::numbers::pi * 0.25 * dr * dr);
+  seeds.domain.push_back(Mat<2>::Identity() * (0.25 * std::sqrt(std::numbers::pi) * dr));
+  for (int i = 1; i <= n; ++i) {
+    const double r = i * dr;
+    const int count = std::max(3, static_cast<int>(std::lround(2 * std::numbers::pi * i)));
+    const double dtheta = 2 * std::numbers::pi / count;
+    const double phase = (i % 2 == 0) ? 0.5 * dtheta : 0.0;
+    for (int k = 0; k < count; ++k) {
+      const double th = phase + k * dtheta;
+      const Vec<2> er(std::cos(th), std::sin(th)), et(-std::sin(th), std::cos(th));
+      seeds.x.push_back(center + r * er);
+      seeds.volume.push_back(r * dr * dtheta);  // annulus 2 pi r dr shared by `count` points
+      Mat<2> dom;
+      dom.col(0) = 0.5 * dr * er;
+      dom.col(1) = 0.5 * r * dtheta * et;
+      seeds.domain.push_back(dom);
+    }
+  }
   return seeds;
 }
 

@@ -56,16 +56,22 @@ struct SqueezeSetup {
   double lateral_margin = 0.6;  // grid half-width beyond R, in diameters
   double offset = 0.0;          // disk centre above a node row, in cells (a multiple of 1/(2 ppc))
   double wall_range = 1.0;      // mpm::ContactSettings::wall_range [cells]
+  bool polar = false;           // seed the disk on rings (points::seed_disk_polar), else a lattice
 };
 
-// One sample of the squeeze curve.
+// One sample of the squeeze curve. Contact Dynamics gives impulses per step, which chatter from
+// step to step where a node row meets a wall; the forces are therefore the impulses summed over
+// the steps since the previous sample divided by that time, at the window's mean approach.
 struct SqueezeSample {
-  double delta = 0;                 // top wall travel minus the initial gaps (loss of diameter) [m]
-  double p_top = 0;                 // force of the disk on the top wall, upward [N/m]
-  double p_bottom = 0;              // force of the disk on the bottom wall, downward [N/m]
+  double delta = 0;                 // mean top wall travel over the window (loss of diameter) [m]
+  double p_top = 0;                 // mean force of the disk on the top wall, upward [N/m]
+  double p_bottom = 0;              // mean force of the disk on the bottom wall, downward [N/m]
   double kinetic = 0, elastic = 0;  // energies [J/m]
   double volume = 0;                // total point volume sum J V0 [m^2]
   std::int64_t active = 0;          // active contacts
+  double penetration = 0;           // deepest point domain beyond either wall [m]
+  double mean_ln_j = 0;   // sum V0 ln J / sum V0, averaged over the window like the forces [-]
+  double mean_shear = 0;  // sum V0 (b_xx + b_yy - 2) / sum V0, b = F F^T, window average [-]
 };
 
 struct SqueezeResult {
@@ -98,11 +104,14 @@ inline SqueezeResult run_squeeze(const SqueezeSetup& su) {
   const Vec<2> c(half_x * h, (half_y + su.offset) * h);
   // The walls touch the extreme point domains (half-width lp = h / (2 ppc)): the gaps start at 0.
   const double lp = 0.5 * h / su.ppc;
-  auto seeds = points::seed_ball<2>(model.grid.origin(), h, su.ppc, c, su.radius);
+  auto seeds = su.polar ? points::seed_disk_polar(c, su.radius, h / su.ppc)
+                        : points::seed_ball<2>(model.grid.origin(), h, su.ppc, c, su.radius);
   double ymin = std::numeric_limits<double>::infinity(), ymax = -ymin;
-  for (const auto& x : seeds.x) {
-    ymin = std::min(ymin, x[1] - lp);
-    ymax = std::max(ymax, x[1] + lp);
+  for (std::size_t i = 0; i < seeds.x.size(); ++i) {
+    // Extent of the point's domain along y: sum of |e_y . r_k| over its half-edges.
+    const double ey = seeds.domain.empty() ? lp : seeds.domain[i].row(1).cwiseAbs().sum();
+    ymin = std::min(ymin, seeds.x[i][1] - ey);
+    ymax = std::max(ymax, seeds.x[i][1] + ey);
   }
   res.diameter = ymax - ymin;
   const double v = su.wall_speed;
@@ -125,6 +134,10 @@ inline SqueezeResult run_squeeze(const SqueezeSetup& su) {
   const double t_end = su.final_approach / v;
   const double sample_every = t_end / su.samples;
   double t = 0, next_sample = sample_every;
+  double window_t = 0, window_delta = 0, impulse_top = 0, impulse_bottom = 0;
+  double window_ln_j = 0, window_shear = 0;
+  double v0 = 0;
+  for (std::size_t p = 0; p < model.points.size(); ++p) v0 += model.points.volume0[p];
   while (t < t_end * (1 - 1e-12)) {
     double dt = std::min(res.dt, t_end - t);
     mpm::StepStats st;
@@ -143,6 +156,15 @@ inline SqueezeResult run_squeeze(const SqueezeSetup& su) {
       break;
     }
     solver.commit();
+    window_delta += v * (t + 0.5 * dt) * dt;
+    impulse_top += st.wall_force[1][1] * dt;
+    impulse_bottom -= st.wall_force[0][1] * dt;
+    window_t += dt;
+    for (std::size_t p = 0; p < model.points.size(); ++p) {
+      const Mat<2>& F = model.points.F[p];
+      window_ln_j += dt * model.points.volume0[p] * std::log(F.determinant()) / v0;
+      window_shear += dt * model.points.volume0[p] * ((F * F.transpose()).trace() - 2) / v0;
+    }
     t += dt;
     ++res.steps;
     res.iterations += st.iterations;
@@ -151,8 +173,19 @@ inline SqueezeResult run_squeeze(const SqueezeSetup& su) {
     if (t >= next_sample * (1 - 1e-9) || t >= t_end * (1 - 1e-12)) {
       next_sample += sample_every;
       const auto d = mpm::diagnostics(model);
-      res.curve.push_back({v * t, st.wall_force[1][1], -st.wall_force[0][1], d.kinetic, d.elastic,
-                           d.volume, st.active_contacts});
+      double pen = 0;
+      const double y_top = ymax - v * t;
+      for (std::size_t p = 0; p < model.points.size(); ++p) {
+        const Vec<2> ey =
+            model.points.domain[p].transpose() * (model.points.F[p].transpose() * Vec<2>(0, 1));
+        const double e = ey.cwiseAbs().sum();
+        pen = std::max({pen, model.points.x[p][1] + e - y_top, ymin - (model.points.x[p][1] - e)});
+      }
+      res.curve.push_back({window_delta / window_t, impulse_top / window_t,
+                           impulse_bottom / window_t, d.kinetic, d.elastic, d.volume,
+                           st.active_contacts, pen, window_ln_j / window_t,
+                           window_shear / window_t});
+      window_t = window_delta = impulse_top = impulse_bottom = window_ln_j = window_shear = 0;
     }
   }
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -172,6 +205,21 @@ inline double load_at(const SqueezeResult& r, double delta) {
   return -1;
 }
 
+// Root mean square of P_sim / P_Hertz - 1 over the samples with lo <= Delta/D <= hi.
+inline double hertz_rms_error(const SqueezeSetup& su, const SqueezeResult& r, double lo,
+                              double hi) {
+  const double es = plane_strain_modulus(su.lambda, su.mu);
+  double sum = 0;
+  int n = 0;
+  for (const auto& s : r.curve) {
+    const double x = s.delta / r.diameter;
+    if (x < lo * (1 - 1e-9) || x > hi * (1 + 1e-9)) continue;
+    sum += std::pow(SqueezeResult::load(s) / hertz_load(s.delta, su.radius, es) - 1, 2);
+    ++n;
+  }
+  return n > 0 ? std::sqrt(sum / n) : std::numeric_limits<double>::infinity();
+}
+
 // Prints a squeeze curve against 2D Hertz (method.md §7) and returns the largest relative error
 // of the mean wall load over the samples with lo <= Delta/D <= hi.
 inline double print_hertz(const char* label, const SqueezeSetup& su, const SqueezeResult& r,
@@ -184,14 +232,15 @@ inline double print_hertz(const char* label, const SqueezeSetup& su, const Squee
       static_cast<long long>(r.steps), static_cast<long long>(r.cuts),
       static_cast<double>(r.iterations) / static_cast<double>(std::max<std::int64_t>(r.steps, 1)),
       r.seconds);
-  std::printf("  %10s %8s %10s %10s %10s %10s %8s %9s\n", "Delta [m]", "Delta/D", "P_top",
-              "P_bottom", "P_sim", "P_Hertz", "error", "Ekin/Eel");
+  std::printf("  %10s %8s %10s %10s %10s %10s %8s %9s %9s\n", "Delta [m]", "Delta/D", "P_top",
+              "P_bottom", "P_sim", "P_Hertz", "error", "Ekin/Eel", "pen/h");
   double worst = 0;
   for (const auto& s : r.curve) {
     const double ph = hertz_load(s.delta, su.radius, es), p = SqueezeResult::load(s);
     const double x = s.delta / r.diameter, err = p / ph - 1;
-    std::printf("  %10.4e %8.4f %10.2f %10.2f %10.2f %10.2f %+8.3f %9.2e\n", s.delta, x, s.p_top,
-                s.p_bottom, p, ph, err, s.kinetic / std::max(s.elastic, 1e-300));
+    std::printf("  %10.4e %8.4f %10.2f %10.2f %10.2f %10.2f %+8.3f %9.2e %9.2e\n", s.delta, x,
+                s.p_top, s.p_bottom, p, ph, err, s.kinetic / std::max(s.elastic, 1e-300),
+                s.penetration / r.h);
     if (x >= lo * (1 - 1e-9) && x <= hi * (1 + 1e-9)) worst = std::max(worst, std::abs(err));
   }
   std::printf("  %s: largest |P_sim/P_Hertz - 1| for %.3f <= Delta/D <= %.3f: %.3f\n", label, lo,

@@ -57,8 +57,9 @@ struct GrainSection {
   std::vector<double> min_corner;  ///< lower corner [m] (rectangle)
   std::vector<double> max_corner;  ///< upper corner [m] (rectangle)
   int points_per_cell = 2;         ///< material points per cell along each axis [-]
-  InitialVelocity initial;         ///< initial velocity field
-  std::int64_t line = 0;           ///< line of the table in the input
+  std::string seeding;      ///< "lattice" or "polar" (disks, packings); empty: polar for disks
+  InitialVelocity initial;  ///< initial velocity field
+  std::int64_t line = 0;    ///< line of the table in the input
 };
 
 /// [[boundary]]: prescribed nodal velocity components on a set of grid nodes.

@@ -28,8 +28,9 @@ struct Model {
     densities.push_back(density);
     return static_cast<int>(laws.size()) - 1;
   }
-  /// Adds a grain from seeded points; `half_width` [m] = half the seeding spacing (uGIMP lp);
-  /// `velocity(x)` gives the initial velocity [m/s]. Returns the grain index.
+  /// Adds a grain from seeded points; `half_width` [m] = half the seeding spacing (uGIMP lp, and
+  /// the points' square domain when the seeds carry none); `velocity(x)` gives the initial
+  /// velocity [m/s]. Returns the grain index.
   int add_grain(const points::Seeds<Dim>& seeds, int material, double half_width,
                 const std::function<Vec<Dim>(const Vec<Dim>&)>& velocity) {
     points::Grain g;
@@ -39,8 +40,10 @@ struct Model {
     g.history_offset = static_cast<std::int64_t>(points.history.size());
     const auto gi = static_cast<std::int32_t>(grains.size());
     for (std::size_t i = 0; i < seeds.x.size(); ++i)
-      points.add(seeds.x[i], velocity ? velocity(seeds.x[i]) : Vec<Dim>::Zero(),
-                 densities[material] * seeds.volume[i], seeds.volume[i], gi);
+      points.add(
+          seeds.x[i], velocity ? velocity(seeds.x[i]) : Vec<Dim>::Zero(),
+          densities[material] * seeds.volume[i], seeds.volume[i],
+          seeds.domain.empty() ? Mat<Dim>(half_width * Mat<Dim>::Identity()) : seeds.domain[i], gi);
     g.end = static_cast<std::int64_t>(points.size());
     const std::size_t hs = static_cast<std::size_t>(laws[material]->history_size());
     const std::size_t h0 = points.history.size();

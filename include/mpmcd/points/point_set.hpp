@@ -29,13 +29,16 @@ struct PointSet {
   std::vector<double> mass;         ///< mass [kg] (per unit thickness in 2D: kg/m)
   std::vector<double> volume0;      ///< initial volume [m^Dim]
   std::vector<double> volume;       ///< current volume J * volume0 [m^Dim]
+  std::vector<Mat<Dim>> domain;     ///< reference domain half-edge vectors (columns) [m]
   std::vector<std::int32_t> grain;  ///< grain index
   std::vector<double> history;  ///< law history variables, per grain blocks (Grain::history_offset)
 
   /// Number of points.
   std::size_t size() const { return x.size(); }
-  /// Appends a point at rest with F = I and zero stress.
-  void add(const Vec<Dim>& pos, const Vec<Dim>& vel, double m, double vol, std::int32_t g) {
+  /// Appends a point with F = I and zero stress; `dom` holds its reference domain's half-edge
+  /// vectors as columns [m].
+  void add(const Vec<Dim>& pos, const Vec<Dim>& vel, double m, double vol, const Mat<Dim>& dom,
+           std::int32_t g) {
     x.push_back(pos);
     v.push_back(vel);
     F.push_back(Mat<Dim>::Identity());
@@ -44,6 +47,7 @@ struct PointSet {
     mass.push_back(m);
     volume0.push_back(vol);
     volume.push_back(vol);
+    domain.push_back(dom);
     grain.push_back(g);
   }
 };

@@ -11,6 +11,9 @@ template <int Dim>
 struct Seeds {
   std::vector<Vec<Dim>> x;     ///< point positions [m]
   std::vector<double> volume;  ///< point volumes [m^Dim]
+  /// Reference domain of each point: its columns are the half-edge vectors of a parallelogram
+  /// (2D) / parallelepiped (3D) [m]. Empty: the grain's lattice square of half-width lp.
+  std::vector<Mat<Dim>> domain;
 };
 
 /// Lattice spacing of `ppc` points per cell of size `h` [m].
@@ -30,6 +33,15 @@ Seeds<Dim> seed_ball(const Vec<Dim>& origin, double h, int ppc, const Vec<Dim>& 
 template <int Dim>
 Seeds<Dim> seed_box(const Vec<Dim>& origin, double h, int ppc, const Vec<Dim>& lo,
                     const Vec<Dim>& hi);
+
+/// Seeds a disk of `center` [m] and `radius` [m] on concentric rings (polar seeding): a central
+/// point for the disk of radius dr/2, then rings of mid-radius r_i = i dr, i = 1..n, with
+/// dr = radius / (n + 1/2) and n = max(1, round(radius / spacing - 1/2)); ring i holds
+/// N_i = round(2 pi i) points (staggered by half a spacing from ring to ring), each with the
+/// volume 2 pi r_i dr / N_i of its annular sector and a domain with the half-edges dr/2 e_r and
+/// (pi r_i / N_i) e_theta, so the outermost domains are tangent to the circle and the volumes sum
+/// to pi r^2 exactly. `spacing` [m] is the target distance between points (h / ppc).
+Seeds<2> seed_disk_polar(const Vec<2>& center, double radius, double spacing);
 
 /// Exact measure of a ball of `radius` [m]: pi r^2 in 2D, 4/3 pi r^3 in 3D [m^Dim].
 template <int Dim>
