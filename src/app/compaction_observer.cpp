@@ -94,7 +94,7 @@ std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm
   }
   if (contact_) {
     const auto z = analysis::coordination(analysis::contact_impulses(problem), grains_);
-    out += fmt::format(",{:.12g},{},{},{}", z.z, z.pairs, z.grains, z.rattlers);
+    out += fmt::format(",{:.17g},{},{},{}", z.z, z.pairs, z.grains, z.rattlers);
   }
   return out;
 }
