@@ -49,42 +49,18 @@ fs::path scratch(const std::string& name) {
 constexpr double kPhiStop = 0.8;  // [stop] phi of compaction.toml
 constexpr double kMp = 6e6;       // lambda + 2 mu of compaction.toml [Pa]
 
-// The tiny compaction, run once for all tests.
-class Compaction : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    dir_ = new fs::path(scratch("run"));
-    result_ = new Result(run("run -t 1 " + std::string(MPMCD_TEST_DIR) + "/compaction.toml -o " +
-                             (*dir_ / "out").string()));
-    if (result_->code == 0)
-      csv_ = new TimeSeries(
-          mpmcd::analysis::read_time_series((*dir_ / "out" / "compaction.csv").string()));
-  }
-  static void TearDownTestSuite() {
-    delete csv_;
-    delete result_;
-    delete dir_;
-  }
-  void SetUp() override {
-    ASSERT_EQ(result_->code, 0) << result_->output;
-    ASSERT_NE(csv_, nullptr);
-    ASSERT_GT(csv_->rows(), 20u);
-  }
-  const std::vector<double>& col(const std::string& name) { return csv_->column(name); }
-
-  static fs::path* dir_;
-  static Result* result_;
-  static TimeSeries* csv_;
+// The tiny compaction run and its CSV time series. One test runs it and checks everything on it
+// (ctest runs every test in its own process: one run instead of one per check).
+struct TinyRun {
+  fs::path dir;
+  Result result;
+  TimeSeries csv;
+  const std::vector<double>& col(const std::string& name) const { return csv.column(name); }
 };
-fs::path* Compaction::dir_ = nullptr;
-Result* Compaction::result_ = nullptr;
-TimeSeries* Compaction::csv_ = nullptr;
 
-}  // namespace
-
-TEST_F(Compaction, Eq9IdentityHoldsOnEveryRow) {
-  const auto &phi = col("phi"), &eps = col("eps"), &lnvs = col("ln_Vs_Vs0"), &h = col("h");
-  const auto &vs = col("Vs"), &area = col("box_area"), &width = col("width");
+void Eq9IdentityHoldsOnEveryRow(const TinyRun& r) {
+  const auto &phi = r.col("phi"), &eps = r.col("eps"), &lnvs = r.col("ln_Vs_Vs0"), &h = r.col("h");
+  const auto &vs = r.col("Vs"), &area = r.col("box_area"), &width = r.col("width");
   double worst = 0;
   for (std::size_t i = 0; i < phi.size(); ++i) {
     worst = std::max(worst, std::fabs(lnvs[i] - (std::log(phi[i] / phi[0]) + eps[i])));
@@ -101,8 +77,8 @@ TEST_F(Compaction, Eq9IdentityHoldsOnEveryRow) {
   EXPECT_LT(lnvs.back(), 0.0);  // compressible grains lose area (lambda = 3 MPa)
 }
 
-TEST_F(Compaction, PhiIncreasesAndTheBoxShrinks) {
-  const auto &phi = col("phi"), &h = col("h");
+void PhiIncreasesAndTheBoxShrinks(const TinyRun& r) {
+  const auto &phi = r.col("phi"), &h = r.col("h");
   for (std::size_t i = 1; i < phi.size(); ++i) {
     EXPECT_GT(phi[i], phi[i - 1]) << "row " << i;
     EXPECT_LT(h[i], h[i - 1]) << "row " << i;
@@ -111,8 +87,8 @@ TEST_F(Compaction, PhiIncreasesAndTheBoxShrinks) {
   EXPECT_NEAR(phi.front(), 0.592377139682, 1e-9);  // 9 disks of packing.csv in 3 x 3.2 mm^2
 }
 
-TEST_F(Compaction, WallStressZeroBeforeFirstContactAndCompressiveAfter) {
-  const auto& active = col("active_contacts");
+void WallStressZeroBeforeFirstContactAndCompressiveAfter(const TinyRun& r) {
+  const auto& active = r.col("active_contacts");
   std::size_t first = 0;
   while (first < active.size() && active[first] == 0) ++first;
   ASSERT_GT(first, 5u) << "the top wall starts 0.22 mm above the grains";
@@ -126,36 +102,36 @@ TEST_F(Compaction, WallStressZeroBeforeFirstContactAndCompressiveAfter) {
                          {"wall_left_stress", "wall_left_fx", "wall_left_fy", 1, 0},
                          {"wall_right_stress", "wall_right_fx", "wall_right_fy", -1, 0}};
   for (const auto& w : walls) {
-    const auto &s = col(w.stress), &fx = col(w.fx), &fy = col(w.fy);
+    const auto &s = r.col(w.stress), &fx = r.col(w.fx), &fy = r.col(w.fy);
     for (std::size_t i = 0; i < first; ++i) EXPECT_EQ(s[i], 0.0) << w.stress << " row " << i;
     for (std::size_t i = 0; i < s.size(); ++i) {
       EXPECT_LE(s[i], 1e-6) << w.stress << " row " << i;  // never tensile (mechanics sign: < 0)
       // sigma = F . n / L (L the box side it closes).
       const double n[2] = {w.nx, w.ny};
-      const double len = n[0] != 0 ? col("h")[i] : col("width")[i];
+      const double len = n[0] != 0 ? r.col("h")[i] : r.col("width")[i];
       EXPECT_NEAR(s[i], (fx[i] * n[0] + fy[i] * n[1]) / len, 1e-9 * (std::fabs(s[i]) + 1))
           << w.stress << " row " << i;
     }
   }
-  const auto& bottom = col("wall_bottom_stress");
-  const auto& over = col("sigma_bottom_over_Mp");
+  const auto& bottom = r.col("wall_bottom_stress");
+  const auto& over = r.col("sigma_bottom_over_Mp");
   EXPECT_LT(bottom.back(), -1e4);  // the bottom wall carries the load at the end
   for (std::size_t i = 0; i < bottom.size(); ++i)
     EXPECT_NEAR(over[i], bottom[i] / kMp, 1e-12) << "row " << i;
 }
 
-TEST_F(Compaction, StopCriterionHonoured) {
-  const auto &phi = col("phi"), &time = col("time");
+void StopCriterionHonoured(const TinyRun& r) {
+  const auto &phi = r.col("phi"), &time = r.col("time");
   // csv_interval = 0: a row per step, so the row before the last is below the target.
   EXPECT_GE(phi.back(), kPhiStop);
   EXPECT_LT(phi[phi.size() - 2], kPhiStop);
   EXPECT_LT(time.back(), 4e-4 - 1e-9);  // before end_time
-  EXPECT_NE(result_->output.find("stop.phi reached: Phi = "), std::string::npos) << result_->output;
+  EXPECT_NE(r.result.output.find("stop.phi reached: Phi = "), std::string::npos) << r.result.output;
 }
 
-TEST_F(Compaction, CoordinationAndLoveWeberStress) {
-  const auto &z = col("Z"), &pairs = col("Z_pairs"), &grains = col("Z_grains");
-  const auto& rattlers = col("rattlers");
+void CoordinationAndLoveWeberStress(const TinyRun& r) {
+  const auto &z = r.col("Z"), &pairs = r.col("Z_pairs"), &grains = r.col("Z_grains");
+  const auto& rattlers = r.col("rattlers");
   for (std::size_t i = 0; i < z.size(); ++i) {
     EXPECT_EQ(grains[i] + rattlers[i], 9.0) << "row " << i;
     EXPECT_DOUBLE_EQ(z[i], grains[i] > 0 ? 2 * pairs[i] / grains[i] : 0.0) << "row " << i;
@@ -164,8 +140,8 @@ TEST_F(Compaction, CoordinationAndLoveWeberStress) {
   EXPECT_GT(z.back(), 1.0);
   // Love-Weber sigma_yy against the mean of the top and bottom wall stresses over the last tenth
   // (a dynamic compaction: within 20 %).
-  const auto &lw = col("lw_syy"), &top = col("wall_top_stress"),
-             &bottom = col("wall_bottom_stress");
+  const auto &lw = r.col("lw_syy"), &top = r.col("wall_top_stress"),
+             &bottom = r.col("wall_bottom_stress");
   double a = 0, b = 0;
   for (std::size_t i = lw.size() - lw.size() / 10; i < lw.size(); ++i) {
     a += lw[i];
@@ -176,23 +152,17 @@ TEST_F(Compaction, CoordinationAndLoveWeberStress) {
   EXPECT_NEAR(a / b, 1.0, 0.2);
 }
 
-TEST_F(Compaction, AnalyzeWritesFitAndFigures) {
-  const fs::path out = *dir_ / "analysis";
-  const Result r = run("analyze " + (*dir_ / "out").string() + " -o " + out.string());
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("jamming: Phi_J = "), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("eq. (10) fit: c1 = "), std::string::npos) << r.output;
+void AnalyzeWritesFitAndFigures(const TinyRun& r) {
+  const fs::path out = r.dir / "analysis";
+  const Result a = run("analyze --no-plots " + (r.dir / "out").string() + " -o " + out.string());
+  ASSERT_EQ(a.code, 0) << a.output;
+  EXPECT_NE(a.output.find("jamming: Phi_J = "), std::string::npos) << a.output;
+  EXPECT_NE(a.output.find("eq. (10) fit: c1 = "), std::string::npos) << a.output;
   for (const char* f : {"compaction_fit.csv", "figure4.csv", "figure5.csv"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
-  if (r.output.find("PNGs not written") == std::string::npos) {
-    EXPECT_TRUE(fs::exists(out / "figure4.png"));
-    EXPECT_TRUE(fs::exists(out / "figure5.png"));
-  }
   const TimeSeries fig4 = mpmcd::analysis::read_time_series((out / "figure4.csv").string());
-  EXPECT_EQ(fig4.rows(), csv_->rows());
+  EXPECT_EQ(fig4.rows(), r.csv.rows());
 }
-
-namespace {
 
 // A synthetic run folder: input copy with lambda, mu and a CSV whose sigma/M_p follows eq. (10)
 // beyond Phi_J = 0.8 (zero before), Z rising from 3.5 to 5.
@@ -240,7 +210,7 @@ TEST(Analyze, ThreeSyntheticRunsOverlaidRecoverC1C2) {
   // The paper's three materials with their c1 and c2 = 0.27 (eq. (10) exactly beyond Phi = 0.8).
   const fs::path dir = scratch("synthetic");
   const double lambdas[3] = {100e6, 3e6, 0.0}, c1s[3] = {0.01, 0.23, 1.3};
-  std::string args = "analyze --no-plots -o ";
+  std::string args = "analyze -o ";
   args += (dir / "analysis").string();
   for (int k = 0; k < 3; ++k) {
     const fs::path folder = dir / fs::path("run").concat(std::to_string(k));
@@ -251,6 +221,10 @@ TEST(Analyze, ThreeSyntheticRunsOverlaidRecoverC1C2) {
   const Result r = run(args);
   ASSERT_EQ(r.code, 0) << r.output;
   std::printf("%s", r.output.c_str());
+  if (r.output.find("PNGs not written") == std::string::npos) {
+    EXPECT_TRUE(fs::exists(dir / "analysis" / "figure4.png")) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "analysis" / "figure5.png")) << r.output;
+  }
   const fs::path fit = dir / "analysis" / "compaction_fit.csv";
   for (std::size_t k = 0; k < 3; ++k) {
     EXPECT_EQ(csv_value(fit, "lambda", k), lambdas[k]);
@@ -358,5 +332,63 @@ TEST(StopCriteria, EachCriterionAtItsThreshold) {
     const StopCase c("");
     const mpmcd::app::CompactionObserver obs(c.config, c.model);
     EXPECT_FALSE(obs.stop_reason(c.model, st, 5e-4).has_value());
+  }
+}
+
+void SnapshotPicturesAtChosenPhi(const TinyRun& r) {
+  if (std::system("/usr/bin/python3 -c 'import numpy, matplotlib' >/dev/null 2>&1") != 0) {
+    std::printf("snapshots not checked: /usr/bin/python3 with numpy and matplotlib not found\n");
+    return;
+  }
+  const fs::path out = r.dir / "snapshots";
+  std::string cmd = "/usr/bin/python3 ";
+  cmd += std::string(MPMCD_SOURCE_DIR) + "/tools/plot_snapshots.py ";
+  cmd += (r.dir / "out").string() + " --phi 0.6 0.8 --field pressure -o " + out.string();
+  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
+  std::string text;
+  std::array<char, 4096> buf{};
+  while (pipe && fgets(buf.data(), buf.size(), pipe)) text += buf.data();
+  ASSERT_EQ(pipe ? pclose(pipe) : -1, 0) << text;
+  EXPECT_TRUE(fs::exists(out / "snapshot_phi0.600_pressure.png")) << text;
+  EXPECT_TRUE(fs::exists(out / "snapshot_phi0.800_pressure.png")) << text;
+  // Phi = 0.6 is nearest to the first snapshot (Phi0 = 0.592).
+  EXPECT_NE(text.find("compaction_000000.vtu"), std::string::npos) << text;
+}
+
+TEST(Compaction, TinyRunObservablesAnalysisAndSnapshots) {
+  TinyRun r;
+  r.dir = scratch("run");
+  r.result = run("run -t 1 " + std::string(MPMCD_TEST_DIR) + "/compaction.toml -o " +
+                 (r.dir / "out").string());
+  ASSERT_EQ(r.result.code, 0) << r.result.output;
+  r.csv = mpmcd::analysis::read_time_series((r.dir / "out" / "compaction.csv").string());
+  ASSERT_GT(r.csv.rows(), 20u);
+  {
+    SCOPED_TRACE("Eq9IdentityHoldsOnEveryRow");
+    Eq9IdentityHoldsOnEveryRow(r);
+  }
+  {
+    SCOPED_TRACE("PhiIncreasesAndTheBoxShrinks");
+    PhiIncreasesAndTheBoxShrinks(r);
+  }
+  {
+    SCOPED_TRACE("WallStressZeroBeforeFirstContactAndCompressiveAfter");
+    WallStressZeroBeforeFirstContactAndCompressiveAfter(r);
+  }
+  {
+    SCOPED_TRACE("StopCriterionHonoured");
+    StopCriterionHonoured(r);
+  }
+  {
+    SCOPED_TRACE("CoordinationAndLoveWeberStress");
+    CoordinationAndLoveWeberStress(r);
+  }
+  {
+    SCOPED_TRACE("AnalyzeWritesFitAndFigures");
+    AnalyzeWritesFitAndFigures(r);
+  }
+  {
+    SCOPED_TRACE("SnapshotPicturesAtChosenPhi");
+    SnapshotPicturesAtChosenPhi(r);
   }
 }
