@@ -63,9 +63,7 @@ std::string CompactionObserver::csv_header() const {
     for (const auto& w : config_.walls) h += ",wall_" + w.name + "_stress";
     if (mp_) h += ",sigma_bottom_over_Mp";
     h += ",lw_sxx,lw_syy,lw_sxy";
-  } else {
-    h += ",Vs,ln_Vs_Vs0";
-  }
+  }  // without a box: Vs is the `volume` column already
   if (contact_) h += ",Z,Z_pairs,Z_grains,rattlers";
   return h;
 }
@@ -73,8 +71,8 @@ std::string CompactionObserver::csv_header() const {
 std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm::StepStats& step,
                                            const contact::Problem<2>& problem, double t) const {
   std::string out;
-  const double vs = grain_area(model);
   if (box_) {
+    const double vs = grain_area(model);
     const analysis::Box box = analysis::box_at(walls_, *box_, t);
     const auto s = analysis::compaction_state(box, box0_, vs, vs0_);
     out += fmt::format(",{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.height,
@@ -89,8 +87,6 @@ std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm
     if (mp_) out += fmt::format(",{:.12e}", bottom / *mp_);
     const Mat<2> lw = analysis::love_weber_stress(model.points, box.area());
     out += fmt::format(",{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1), lw(0, 1));
-  } else {
-    out += fmt::format(",{:.17g},{:.17g}", vs, std::log(vs / vs0_));
   }
   if (contact_) {
     const auto z = analysis::coordination(analysis::contact_impulses(problem), grains_);

@@ -20,7 +20,8 @@ class CompactionObserver {
   /// t = 0 (call before the first step).
   CompactionObserver(const io::Config& config, const mpm::Model<2>& model);
 
-  /// The extra CSV header, starting with a comma ("" if there is nothing to add).
+  /// The extra CSV header, starting with a comma: the box columns if the walls form a box, the
+  /// Z columns if contact is on ("" if neither, so runs without walls keep their columns).
   std::string csv_header() const;
 
   /// The extra CSV fields of the committed state at time t [s], starting with a comma; `step` is
