@@ -34,6 +34,14 @@ class CompactionObserver {
   std::optional<std::string> stop_reason(const mpm::Model<2>& model, const mpm::StepStats& step,
                                          double t) const;
 
+  /// Replaces V_s0, the grains' area at t = 0 [m^2] (a restarted run must pass the value of the
+  /// original start, e.g. from the first CSV row, since the constructor measures the model it is
+  /// given; the box at t = 0 follows from the walls and needs nothing).
+  void set_initial_grain_area(double vs0) { vs0_ = vs0; }
+
+  /// The grains' area V_s0 at t = 0 used for ln(V_s/V_s0) [m^2].
+  double initial_grain_area() const { return vs0_; }
+
   /// True when the walls form a box (h, ε, Φ and the stresses are measured).
   bool has_box() const { return box_.has_value(); }
 
