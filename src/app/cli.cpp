@@ -5,6 +5,7 @@
 
 #include <iostream>
 
+#include "mpmcd/app/analyze.hpp"
 #include "mpmcd/app/simulation.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
@@ -57,6 +58,23 @@ int run_cli(int argc, char** argv) {
   pack->add_option("input", pack_input, "packing input (TOML)")->required();
   pack->add_flag("-q,--quiet", pack_quiet, "only the summary line");
 
+  AnalyzeOptions analyze_opt;
+  auto* analyze =
+      cli.add_subcommand("analyze",
+                         "compaction analysis of run folders: Phi_J, eq. (10) fit, Figures 4-5 "
+                         "(docs/observables.md)");
+  analyze->add_option("folders", analyze_opt.folders, "run output folders")->required();
+  analyze->add_option("-o,--output", analyze_opt.output_dir,
+                      "output folder (default <folder>/analysis, or compaction_analysis)");
+  analyze
+      ->add_option("--jam-stress", analyze_opt.jamming.stress,
+                   "jammed: -sigma/M_p of the bottom wall at least this from Phi_J on")
+      ->check(CLI::PositiveNumber);
+  analyze->add_option("--jam-z", analyze_opt.jamming.min_z, "jammed: also Z at least this")
+      ->check(CLI::NonNegativeNumber);
+  bool analyze_no_plots = false;
+  analyze->add_flag("--no-plots", analyze_no_plots, "write the CSV files only");
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -77,6 +95,9 @@ int run_cli(int argc, char** argv) {
     } else if (*pack) {
       setup_logging(pack_quiet ? Verbosity::kQuiet : Verbosity::kNormal);
       return packing::pack_command(pack_input, pack_quiet);
+    } else if (*analyze) {
+      analyze_opt.plots = !analyze_no_plots;
+      return analyze_command(analyze_opt);
     } else if (*list) {
       if (list_what == "input")
         std::cout << io::input_reference_markdown();

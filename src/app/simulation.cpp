@@ -10,6 +10,7 @@
 #include <map>
 #include <numbers>
 
+#include "mpmcd/app/compaction_observer.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/vtu.hpp"
@@ -271,7 +272,9 @@ void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {
 
 class Outputs {
  public:
-  Outputs(const io::Config& cfg, const std::string& dir) : cfg_(cfg), dir_(dir) {
+  // `extra_header`: further CSV columns (CompactionObserver), starting with a comma.
+  Outputs(const io::Config& cfg, const std::string& dir, const std::string& extra_header)
+      : cfg_(cfg), dir_(dir) {
     fs::create_directories(dir_);
     // Input copy, stamped with the version that ran it.
     io::write_file_atomic(
@@ -284,13 +287,13 @@ class Outputs {
     csv_ << "step,time,dt,newton_iterations,linear_solves,kinetic_energy,elastic_energy,"
             "total_energy,momentum_x,momentum_y,mass,volume,contacts,active_contacts,gs_sweeps";
     for (const auto& w : cfg.walls) csv_ << ",wall_" << w.name << "_fx,wall_" << w.name << "_fy";
-    csv_ << "\n";
+    csv_ << extra_header << "\n";
     if (cfg_.output.vtu)
       pvd_ = std::make_unique<io::PvdSeries>(
           (fs::path(dir_) / (cfg.simulation.name + ".pvd")).string());
   }
   void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& st,
-               const mpm::Diagnostics<2>& d) {
+               const mpm::Diagnostics<2>& d, const std::string& extra) {
     csv_ << fmt::format(
         "{},{:.12e},{:.6e},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", step, t,
         dt, st.iterations, st.linear_solves, d.kinetic, d.elastic, d.kinetic + d.elastic,
@@ -301,7 +304,7 @@ class Outputs {
       csv_ << fmt::format(",{:.12e},{:.12e}", have ? st.wall_force[k][0] : 0.0,
                           have ? st.wall_force[k][1] : 0.0);
     }
-    csv_ << "\n";
+    csv_ << extra << "\n";
     csv_.flush();
   }
   void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver, double t) {
@@ -390,7 +393,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
   if (fs::path(summary.output_dir).is_relative() && opt.output_dir.empty())
     summary.output_dir =
         (fs::path(cfg.source_path).parent_path() / summary.output_dir).lexically_normal().string();
-  Outputs out(cfg, summary.output_dir);
+  const CompactionObserver observer(cfg, model);
+  Outputs out(cfg, summary.output_dir, observer.csv_header());
   mpm::ImplicitSolver<2> solver(model.grid, settings, model.points, model.grains, model.law_ptrs());
   solver.set_boundary_conditions(build_boundaries(cfg, model.grid, 0.0));
 
@@ -405,7 +409,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
   auto record = [&](bool force) {
     const double eps = 1e-9 * dt_nominal;
     if (force || t >= next_csv - eps) {
-      out.csv_row(summary.steps, t, dt, last, mpm::diagnostics(model));
+      out.csv_row(summary.steps, t, dt, last, mpm::diagnostics(model),
+                  observer.csv_fields(model, last, solver.contact_problem(), t));
       next_csv = t + cfg.output.csv_interval;
     }
     if (force || t >= next_vtu - eps) {
@@ -449,7 +454,13 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
       good_since_cut = 0;
       log().info("dt restored to {:.4g} s at t = {:.9g} s", dt, t);
     }
-    record(t >= t_end - 1e-9 * dt_nominal);
+    const auto stop = observer.stop_reason(model, st, t);  // [stop] criteria
+    record(stop || t >= t_end - 1e-9 * dt_nominal);
+    if (stop) {
+      log().info("step {}, t = {:.9g} s: {}", summary.steps, t, *stop);
+      summary.stop_reason = *stop;
+      break;
+    }
     const auto now = std::chrono::steady_clock::now();
     if (std::chrono::duration<double>(now - last_progress).count() >=
         cfg.output.progress_interval) {

@@ -95,6 +95,7 @@ Schema build_schema() {
         KeySpec::subtable("solver", "solver", "Newton and linear solver").defaults("its defaults"),
         KeySpec::subtable("contact", "contact", "Contact Dynamics").defaults("its defaults"),
         KeySpec::table_array("walls", "walls[]", "rigid walls").defaults("none"),
+        KeySpec::subtable("stop", "stop", "compaction stop criteria").defaults("none"),
         KeySpec::subtable("output", "output", "output files").defaults("its defaults")},
        ""});
 
@@ -356,6 +357,25 @@ Schema build_schema() {
        ""});
 
   s.tables.push_back(
+      {"stop",
+       "[stop]",
+       "Stop criteria of a compaction (docs/observables.md): the run stops at the first criterion "
+       "reached, or at `time.end_time`, and logs which. They need four walls forming a box "
+       "(normals +x, -x, +y, -y). Checked after every step.",
+       {KeySpec::number("phi", "", "stop when the solid fraction Phi = Vs/V reaches this")
+            .greater_than(0.0)
+            .at_most(1.0)
+            .defaults("none"),
+        KeySpec::number("strain", "", "stop when |eps| = |ln(h/h0)| reaches this")
+            .greater_than(0.0)
+            .defaults("none"),
+        KeySpec::number("stress", "Pa",
+                        "stop when the bottom wall's compressive stress -sigma reaches this")
+            .greater_than(0.0)
+            .defaults("none")},
+       ""});
+
+  s.tables.push_back(
       {"output",
        "[output]",
        "Where and how often to write. An interval of 0 means every step.",
@@ -402,6 +422,7 @@ class ConfigReader {
     read_solver(r, c);
     read_contact(r, c);
     read_walls(r, c);
+    read_stop(r, c);
     read_output(r, c);
     return c;
   }
@@ -745,6 +766,31 @@ class ConfigReader {
       for (double& x : w.normal) x /= len;
       c.walls.push_back(std::move(w));
     }
+  }
+
+  void read_stop(const TableReader& root, Config& c) {
+    if (!root.subtable("stop")) return;
+    TableReader r = sub(root, "stop", "stop");
+    StopSection& s = c.stop;
+    s.line = r.line();
+    r.read("phi", s.phi);
+    r.read("strain", s.strain);
+    r.read("stress", s.stress);
+    // The criteria are measured on the box of four axis-aligned walls (analysis::find_box).
+    int axes[4] = {0, 0, 0, 0};  // +x, -x, +y, -y
+    for (const auto& w : c.walls)
+      for (int k = 0; k < 4; ++k) {
+        const double nx = k < 2 ? (k == 0 ? 1.0 : -1.0) : 0.0;
+        const double ny = k < 2 ? 0.0 : (k == 2 ? 1.0 : -1.0);
+        if (std::fabs(w.normal[0] - nx) <= 1e-12 && std::fabs(w.normal[1] - ny) <= 1e-12) ++axes[k];
+      }
+    const bool box =
+        c.walls.size() == 4 && axes[0] == 1 && axes[1] == 1 && axes[2] == 1 && axes[3] == 1;
+    if (!box && (s.phi > 0 || s.strain > 0 || s.stress > 0))
+      r.fail_table(
+          fmt::format("stop criteria need four [[walls]] forming a box (normals +x, -x, "
+                      "+y, -y), got {} walls",
+                      c.walls.size()));
   }
 
   void read_output(const TableReader& root, Config& c) {

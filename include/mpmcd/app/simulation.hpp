@@ -26,6 +26,7 @@ struct RunSummary {
   double time = 0;                     ///< final simulated time [s]
   double wall_seconds = 0;             ///< wall time of the stepping loop [s]
   std::string output_dir;              ///< where the outputs are
+  std::string stop_reason;             ///< the [stop] criterion reached, "" if end_time
 };
 
 /// Builds the 2D model (grid, materials, seeded grains, initial velocities) from the input;

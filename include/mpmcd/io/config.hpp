@@ -130,6 +130,15 @@ struct WallSection {
   std::int64_t line = 0;         ///< line of the table in the input
 };
 
+/// [stop]: optional stop criteria of a compaction (need four walls forming a box); the run stops
+/// at the first one reached or at [time] end_time (docs/observables.md). 0 = not set.
+struct StopSection {
+  double phi = 0.0;       ///< stop when the solid fraction Φ >= phi [-]
+  double strain = 0.0;    ///< stop when |ε| = |ln(h/h0)| >= strain [-]
+  double stress = 0.0;    ///< stop when the bottom wall's compressive stress -σ >= stress [Pa]
+  std::int64_t line = 0;  ///< line of the table in the input
+};
+
 /// [output]: where and how often to write.
 struct OutputSection {
   std::string folder = "output";   ///< output folder (created) [-]
@@ -153,6 +162,7 @@ struct Config {
   SolverSection solver;
   ContactSection contact;
   std::vector<WallSection> walls;
+  StopSection stop;
   OutputSection output;
 };
 

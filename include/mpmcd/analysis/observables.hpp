@@ -1,0 +1,119 @@
+#pragma once
+/// Observables of the compaction experiment (method.md §6, paper §4; definitions in
+/// docs/observables.md): the box formed by four axis-aligned walls, its height, strain and solid
+/// fraction Φ (paper eq. (9)), wall stresses, the coordination number Z of the grain contact
+/// network and the volume-averaged (Love-Weber) stress of the grains. Pure functions on plain data
+/// (2D).
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "mpmcd/contact/problem.hpp"
+#include "mpmcd/core/types.hpp"
+#include "mpmcd/points/point_set.hpp"
+
+namespace mpmcd::analysis {
+
+/// A rigid plane wall: the plane through point + velocity t with unit normal into the domain.
+struct Plane {
+  Vec<2> point = Vec<2>::Zero();     ///< a point of the plane at t = 0 [m]
+  Vec<2> normal = Vec<2>::Zero();    ///< unit normal into the domain [-]
+  Vec<2> velocity = Vec<2>::Zero();  ///< prescribed velocity [m/s]
+};
+
+/// Which of the walls bound an axis-aligned rectangular box (indices into the wall list).
+struct BoxWalls {
+  std::size_t left = 0;    ///< wall with normal +x [-]
+  std::size_t right = 0;   ///< wall with normal -x [-]
+  std::size_t bottom = 0;  ///< wall with normal +y [-]
+  std::size_t top = 0;     ///< wall with normal -y [-]
+};
+
+/// The box at one time.
+struct Box {
+  double x_min = 0, x_max = 0;  ///< positions of the left and right walls [m]
+  double y_min = 0, y_max = 0;  ///< positions of the bottom and top walls [m]
+  /// Width x_max - x_min [m].
+  double width() const { return x_max - x_min; }
+  /// Height h = y_max - y_min [m].
+  double height() const { return y_max - y_min; }
+  /// Area V = width h [m^2] (2D: volume per unit thickness).
+  double area() const { return width() * height(); }
+};
+
+/// The four walls form a box when there are exactly four and their normals are +x, -x, +y, -y
+/// (each component within 1e-12 of 0 or ±1); nullopt otherwise.
+std::optional<BoxWalls> find_box(std::span<const Plane> walls);
+
+/// The box bounded by the walls at time t [s]: each wall at point + velocity t.
+Box box_at(std::span<const Plane> walls, const BoxWalls& box, double t);
+
+/// Length of wall `k` [m] inside the box: the width for the bottom and top walls, the height for
+/// the left and right walls; 0 if k is not one of the box walls.
+double wall_length(const Box& box, const BoxWalls& walls, std::size_t k);
+
+/// The compaction state of paper §4 at one output.
+struct CompactionState {
+  double height = 0;     ///< box height h [m]
+  double strain = 0;     ///< ε = ln(h/h0) (negative in compaction) [-]
+  double phi = 0;        ///< solid fraction Φ = Vs/V [-]
+  double vs = 0;         ///< grain area Vs = Σ_p V_p [m^2]
+  double ln_vs_vs0 = 0;  ///< ln(Vs/Vs0) [-]
+};
+
+/// Φ = Vs/V, ε = ln(h/h0), ln(Vs/Vs0) for the box `box` (initial box `box0`) and grain areas vs,
+/// vs0 [m^2]. With a constant width, ln(Vs/Vs0) = ln(Φ/Φ0) + ε (paper eq. (9)) to round-off.
+CompactionState compaction_state(const Box& box, const Box& box0, double vs, double vs0);
+
+/// Normal stress on a wall [Pa]: σ = F·n / L with F the force of the grains on the wall [N/m],
+/// n its unit normal into the domain and L its length in contact with the box [m]. Mechanics
+/// convention: negative when the grains push on the wall (compression), like paper eq. (10).
+double wall_normal_stress(const Vec<2>& force_on_wall, const Vec<2>& normal, double length);
+
+/// Volume-averaged (Love-Weber) Cauchy stress of the grains over the area V [m^2]:
+/// σ̄ = (1/V) Σ_p σ_p V_p with V_p the points' current volume (docs/observables.md) [Pa].
+Mat<2> love_weber_stress(const points::PointSet<2>& points, double area);
+
+/// One grid-node contact reduced to what Z needs.
+struct ContactImpulse {
+  std::int32_t a = -1;        ///< grain A, or -1 - k for wall k [-]
+  std::int32_t b = -1;        ///< grain B [-]
+  double normal_impulse = 0;  ///< P·n, positive in compression [N s/m]
+};
+
+/// The contacts of a solved contact problem: grains of the two slots (a = -1 - k for wall k) and
+/// P·n.
+std::vector<ContactImpulse> contact_impulses(const contact::Problem<2>& problem);
+
+/// Settings of the coordination number.
+struct CoordinationSettings {
+  /// A grain pair is in contact when its summed normal impulse exceeds this fraction of the
+  /// largest summed normal impulse of any grain pair (separates real contacts from the
+  /// round-off impulses the Gauss-Seidel tolerance leaves) [-].
+  double relative_threshold = 1e-6;
+  /// A grain's contacts with walls count when deciding whether it is a rattler (a grain held
+  /// between a wall and another grain carries load); they never count as pairs in Z [-].
+  bool walls_hold_grains = true;
+};
+
+/// Coordination of the grain contact network.
+struct Coordination {
+  double z = 0;                    ///< Z = 2 N_pairs / N_grains over the non-rattlers [-]
+  std::int64_t pairs = 0;          ///< grain pairs in contact among the non-rattlers [-]
+  std::int64_t grains = 0;         ///< grains kept (at least two contacts) [-]
+  std::int64_t rattlers = 0;       ///< grains removed (fewer than two contacts) [-]
+  std::int64_t all_pairs = 0;      ///< grain pairs in contact before removing rattlers [-]
+  std::int64_t wall_contacts = 0;  ///< grain-wall pairs in contact (not counted in Z) [-]
+};
+
+/// Coordination number Z (docs/observables.md): contact impulses summed per pair of bodies (all
+/// their nodes); a pair is in contact if its sum exceeds the threshold; grains with fewer than two
+/// contacts (wall contacts included if settings.walls_hold_grains) are removed repeatedly until
+/// none is left (a removed grain's contacts no longer count for its neighbours);
+/// Z = 2 N_pairs / N_grains over the rest with N_pairs the grain-grain pairs (walls excluded),
+/// 0 if no grain is left. `n_grains` is the number of grains in the system.
+Coordination coordination(std::span<const ContactImpulse> contacts, std::int64_t n_grains,
+                          const CoordinationSettings& settings = {});
+
+}  // namespace mpmcd::analysis

@@ -1,0 +1,62 @@
+#pragma once
+/// The compaction observables of a run (docs/observables.md): extra CSV columns (box height, ε, Φ,
+/// Vs, ln(Vs/Vs0), wall stresses, σ/M_p of the bottom wall, Love-Weber stress, coordination Z)
+/// and the [stop] criteria. Wires analysis/ to the model and the solver; used by run_simulation.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mpmcd/analysis/observables.hpp"
+#include "mpmcd/io/config.hpp"
+#include "mpmcd/mpm/model.hpp"
+#include "mpmcd/mpm/solver.hpp"
+
+namespace mpmcd::app {
+
+/// Observables of a compaction, measured on the committed state.
+class CompactionObserver {
+ public:
+  /// Reads the walls, the grains' moduli and the initial box and grain area from the model at
+  /// t = 0 (call before the first step).
+  CompactionObserver(const io::Config& config, const mpm::Model<2>& model);
+
+  /// The extra CSV header, starting with a comma: the box columns if the walls form a box, the
+  /// Z columns if contact is on ("" if neither, so runs without walls keep their columns).
+  std::string csv_header() const;
+
+  /// The extra CSV fields of the committed state at time t [s], starting with a comma; `step` is
+  /// the last converged step (wall forces), `problem` its contact problem (Z).
+  std::string csv_fields(const mpm::Model<2>& model, const mpm::StepStats& step,
+                         const contact::Problem<2>& problem, double t) const;
+
+  /// The first [stop] criterion reached by the committed state at time t [s] (a sentence for the
+  /// log), or nullopt.
+  std::optional<std::string> stop_reason(const mpm::Model<2>& model, const mpm::StepStats& step,
+                                         double t) const;
+
+  /// Replaces V_s0, the grains' area at t = 0 [m^2] (a restarted run must pass the value of the
+  /// original start, e.g. from the first CSV row, since the constructor measures the model it is
+  /// given; the box at t = 0 follows from the walls and needs nothing).
+  void set_initial_grain_area(double vs0) { vs0_ = vs0; }
+
+  /// The grains' area V_s0 at t = 0 used for ln(V_s/V_s0) [m^2].
+  double initial_grain_area() const { return vs0_; }
+
+  /// True when the walls form a box (h, ε, Φ and the stresses are measured).
+  bool has_box() const { return box_.has_value(); }
+
+  /// The grains' P-wave modulus M_p = λ + 2μ [Pa], or nullopt if not unique (docs/observables.md).
+  std::optional<double> p_wave_modulus() const { return mp_; }
+
+ private:
+  const io::Config& config_;
+  std::vector<analysis::Plane> walls_;
+  std::optional<analysis::BoxWalls> box_;
+  analysis::Box box0_;
+  double vs0_ = 0;
+  std::optional<double> mp_;
+  bool contact_ = false;
+  std::int64_t grains_ = 0;
+};
+
+}  // namespace mpmcd::app

@@ -1,0 +1,119 @@
+#include "mpmcd/app/compaction_observer.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <set>
+
+#include "mpmcd/core/log.hpp"
+
+namespace mpmcd::app {
+
+namespace {
+
+double grain_area(const mpm::Model<2>& model) {
+  double vs = 0;
+  for (double v : model.points.volume) vs += v;  // Vs = Σ_p V_p (current volumes)
+  return vs;
+}
+
+Vec<2> force_on(const mpm::StepStats& step, std::size_t k) {
+  if (k >= step.wall_force.size()) return Vec<2>::Zero();  // before the first step
+  return Vec<2>(step.wall_force[k][0], step.wall_force[k][1]);
+}
+
+}  // namespace
+
+CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Model<2>& model)
+    : config_(config) {
+  for (const auto& w : config.walls)
+    walls_.push_back({Vec<2>(w.point.at(0), w.point.at(1)), Vec<2>(w.normal.at(0), w.normal.at(1)),
+                      Vec<2>(w.velocity.at(0), w.velocity.at(1))});
+  box_ = analysis::find_box(walls_);
+  if (box_) box0_ = analysis::box_at(walls_, *box_, 0.0);
+  vs0_ = grain_area(model);
+  grains_ = static_cast<std::int64_t>(model.grains.size());
+  contact_ = config.contact.enabled && (grains_ > 1 || !config.walls.empty());
+  // M_p = λ + 2μ of the grains' material: defined when every material used by a grain has the
+  // same λ and μ (docs/observables.md).
+  std::set<std::pair<double, double>> moduli;
+  bool all = true;
+  for (const auto& g : config.grains)
+    for (const auto& m : config.materials)
+      if (m.name == g.material) {
+        const auto l = m.params.find("lambda"), u = m.params.find("mu");
+        if (l == m.params.end() || u == m.params.end())
+          all = false;
+        else
+          moduli.insert({l->second, u->second});
+      }
+  if (all && moduli.size() == 1) mp_ = moduli.begin()->first + 2 * moduli.begin()->second;
+  if (box_ && !mp_)
+    log().info("sigma_bottom_over_Mp not written: the grains do not share one (lambda, mu)");
+  if (!box_ && !config.walls.empty())
+    log().info(
+        "h, eps, phi and wall stresses not written: the walls do not form a box (four "
+        "walls with normals +x, -x, +y, -y)");
+}
+
+std::string CompactionObserver::csv_header() const {
+  std::string h;
+  if (box_) {
+    h += ",h,width,box_area,eps,phi,Vs,ln_Vs_Vs0";
+    for (const auto& w : config_.walls) h += ",wall_" + w.name + "_stress";
+    if (mp_) h += ",sigma_bottom_over_Mp";
+    h += ",lw_sxx,lw_syy,lw_sxy";
+  }  // without a box: Vs is the `volume` column already
+  if (contact_) h += ",Z,Z_pairs,Z_grains,rattlers";
+  return h;
+}
+
+std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm::StepStats& step,
+                                           const contact::Problem<2>& problem, double t) const {
+  std::string out;
+  if (box_) {
+    const double vs = grain_area(model);
+    const analysis::Box box = analysis::box_at(walls_, *box_, t);
+    const auto s = analysis::compaction_state(box, box0_, vs, vs0_);
+    out += fmt::format(",{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.height,
+                       box.width(), box.area(), s.strain, s.phi, s.vs, s.ln_vs_vs0);
+    double bottom = 0;
+    for (std::size_t k = 0; k < walls_.size(); ++k) {
+      const double sigma = analysis::wall_normal_stress(force_on(step, k), walls_[k].normal,
+                                                        analysis::wall_length(box, *box_, k));
+      if (k == box_->bottom) bottom = sigma;
+      out += fmt::format(",{:.12e}", sigma);
+    }
+    if (mp_) out += fmt::format(",{:.12e}", bottom / *mp_);
+    const Mat<2> lw = analysis::love_weber_stress(model.points, box.area());
+    out += fmt::format(",{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1), lw(0, 1));
+  }
+  if (contact_) {
+    const auto z = analysis::coordination(analysis::contact_impulses(problem), grains_);
+    out += fmt::format(",{:.17g},{},{},{}", z.z, z.pairs, z.grains, z.rattlers);
+  }
+  return out;
+}
+
+std::optional<std::string> CompactionObserver::stop_reason(const mpm::Model<2>& model,
+                                                           const mpm::StepStats& step,
+                                                           double t) const {
+  const auto& c = config_.stop;
+  if (!box_ || (c.phi <= 0 && c.strain <= 0 && c.stress <= 0)) return std::nullopt;
+  const analysis::Box box = analysis::box_at(walls_, *box_, t);
+  const auto s = analysis::compaction_state(box, box0_, grain_area(model), vs0_);
+  if (c.phi > 0 && s.phi >= c.phi)
+    return fmt::format("stop.phi reached: Phi = {:.6f} >= {}", s.phi, c.phi);
+  if (c.strain > 0 && std::fabs(s.strain) >= c.strain)
+    return fmt::format("stop.strain reached: |eps| = {:.6f} >= {}", std::fabs(s.strain), c.strain);
+  if (c.stress > 0) {
+    const double sigma = analysis::wall_normal_stress(force_on(step, box_->bottom),
+                                                      walls_[box_->bottom].normal, box.width());
+    if (-sigma >= c.stress)
+      return fmt::format("stop.stress reached: bottom wall stress -sigma = {:.6g} Pa >= {} Pa",
+                         -sigma, c.stress);
+  }
+  return std::nullopt;
+}
+
+}  // namespace mpmcd::app

@@ -1,0 +1,210 @@
+// Compaction observables on hand-made data: the box from four walls, Φ, ε and the identity of
+// paper eq. (9), wall stress, Love-Weber stress of a uniform state, coordination number Z.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "mpmcd/analysis/observables.hpp"
+#include "mpmcd/analysis/time_series.hpp"
+#include "mpmcd/core/errors.hpp"
+
+using namespace mpmcd;
+using namespace mpmcd::analysis;
+
+namespace {
+
+// A 3 mm x 2 mm box at the origin, top wall moving down at 2 m/s, listed in a shuffled order.
+std::vector<Plane> box_walls() {
+  return {{Vec<2>(0, 2e-3), Vec<2>(0, -1), Vec<2>(0, -2)},   // top
+          {Vec<2>(0, 0), Vec<2>(1, 0), Vec<2>::Zero()},      // left
+          {Vec<2>(3e-3, 0), Vec<2>(-1, 0), Vec<2>::Zero()},  // right
+          {Vec<2>(0, 0), Vec<2>(0, 1), Vec<2>::Zero()}};     // bottom
+}
+
+ContactImpulse pair(int a, int b, double p) {
+  return {a, b, p};
+}
+
+}  // namespace
+
+TEST(Box, FoundFromFourAxisWallsInAnyOrder) {
+  const auto walls = box_walls();
+  const auto b = find_box(walls);
+  ASSERT_TRUE(b.has_value());
+  EXPECT_EQ(b->top, 0u);
+  EXPECT_EQ(b->left, 1u);
+  EXPECT_EQ(b->right, 2u);
+  EXPECT_EQ(b->bottom, 3u);
+  const Box box = box_at(walls, *b, 1e-4);  // top at 2 mm - 0.2 mm
+  EXPECT_DOUBLE_EQ(box.height(), 1.8e-3);
+  EXPECT_DOUBLE_EQ(box.width(), 3e-3);
+  EXPECT_DOUBLE_EQ(box.area(), 5.4e-6);
+  EXPECT_DOUBLE_EQ(wall_length(box, *b, 0), 3e-3);
+  EXPECT_DOUBLE_EQ(wall_length(box, *b, 1), 1.8e-3);
+}
+
+TEST(Box, NotABox) {
+  auto walls = box_walls();
+  walls.pop_back();  // three walls
+  EXPECT_FALSE(find_box(walls).has_value());
+  walls = box_walls();
+  walls[1].normal = Vec<2>(1, 1).normalized();  // tilted wall
+  EXPECT_FALSE(find_box(walls).has_value());
+  walls = box_walls();
+  walls[2].normal = Vec<2>(1, 0);  // two left walls
+  EXPECT_FALSE(find_box(walls).has_value());
+}
+
+TEST(Compaction, PhiStrainAndIdentityOfEq9) {
+  const auto walls = box_walls();
+  const auto b = *find_box(walls);
+  const Box box0 = box_at(walls, b, 0.0);
+  const double vs0 = 4.2e-6;
+  const auto s0 = compaction_state(box0, box0, vs0, vs0);
+  EXPECT_DOUBLE_EQ(s0.phi, 0.7);
+  EXPECT_EQ(s0.strain, 0.0);
+  EXPECT_EQ(s0.ln_vs_vs0, 0.0);
+  for (double t : {1e-5, 2e-4, 5e-4, 9e-4}) {
+    const double vs = vs0 * (1 - 30 * t);  // grains lose area as they are squeezed
+    const auto s = compaction_state(box_at(walls, b, t), box0, vs, vs0);
+    EXPECT_DOUBLE_EQ(s.height, 2e-3 - 2 * t);
+    EXPECT_DOUBLE_EQ(s.strain, std::log((2e-3 - 2 * t) / 2e-3));
+    EXPECT_DOUBLE_EQ(s.phi, vs / (3e-3 * (2e-3 - 2 * t)));
+    EXPECT_NEAR(s.ln_vs_vs0, std::log(s.phi / s0.phi) + s.strain, 1e-14);  // eq. (9)
+  }
+}
+
+TEST(Compaction, WallStressIsNegativeInCompression) {
+  // Grains push the bottom wall (normal +y) down with 30 N/m over 3 mm: -10 kPa.
+  EXPECT_DOUBLE_EQ(wall_normal_stress(Vec<2>(0.5, -30), Vec<2>(0, 1), 3e-3), -1e4);
+  // ... and the top wall (normal -y) up.
+  EXPECT_DOUBLE_EQ(wall_normal_stress(Vec<2>(0, 30), Vec<2>(0, -1), 3e-3), -1e4);
+  // Pulling (adhesion, never in CD) would be positive.
+  EXPECT_DOUBLE_EQ(wall_normal_stress(Vec<2>(-30, 0), Vec<2>(-1, 0), 3e-3), 1e4);
+}
+
+TEST(LoveWeber, UniformStressOverTheSolidFraction) {
+  points::PointSet<2> pts;
+  Mat<2> s;
+  s << -2e5, 3e4, 3e4, -5e5;
+  for (int i = 0; i < 10; ++i) {
+    pts.add(Vec<2>(i, 0), Vec<2>::Zero(), 1.0, 1e-8, Mat<2>::Identity() * 5e-5, 0);
+    pts.volume.back() = 1e-8 * (1 + 0.1 * i);  // current volumes differ
+    pts.sigma.back() = s;
+  }
+  const double vs = 1e-7 * (1 + 0.45);
+  // Over the grains' own area: the uniform stress itself; over a box twice as large: half.
+  EXPECT_LT((love_weber_stress(pts, vs) - s).norm(), 1e-9 * s.norm());
+  EXPECT_LT((love_weber_stress(pts, 2 * vs) - 0.5 * s).norm(), 1e-9 * s.norm());
+}
+
+TEST(Coordination, PairsWithSeveralNodesCountOnce) {
+  // Triangle 0-1-2 with each pair touching at several nodes; a wall contact on grain 0.
+  const std::vector<ContactImpulse> c = {pair(0, 1, 1.0), pair(0, 1, 0.5), pair(1, 2, 2.0),
+                                         pair(2, 1, 0.1), pair(0, 2, 0.3), pair(0, 2, 0.3),
+                                         pair(-1, 0, 5.0)};
+  const auto z = coordination(c, 3);
+  EXPECT_EQ(z.all_pairs, 3);
+  EXPECT_EQ(z.pairs, 3);
+  EXPECT_EQ(z.grains, 3);
+  EXPECT_EQ(z.rattlers, 0);
+  EXPECT_EQ(z.wall_contacts, 1);
+  EXPECT_DOUBLE_EQ(z.z, 2.0);  // 2 * 3 / 3
+}
+
+TEST(Coordination, RattlersRemovedRepeatedly) {
+  // Square 0-1-2-3 with diagonal 0-2 (5 pairs), a chain 3-4-5 hanging off it, grain 6 free,
+  // grain 7 touching only a wall. Removing 5 leaves 4 with one contact: it goes too.
+  const std::vector<ContactImpulse> c = {pair(0, 1, 1), pair(1, 2, 1),  pair(2, 3, 1),
+                                         pair(3, 0, 1), pair(0, 2, 1),  pair(3, 4, 1),
+                                         pair(4, 5, 1), pair(-1, 7, 1), pair(-1, 0, 1)};
+  const auto z = coordination(c, 8);
+  EXPECT_EQ(z.all_pairs, 7);
+  EXPECT_EQ(z.wall_contacts, 2);
+  EXPECT_EQ(z.grains, 4);
+  EXPECT_EQ(z.rattlers, 4);  // 4, 5, 6, 7
+  EXPECT_EQ(z.pairs, 5);
+  EXPECT_DOUBLE_EQ(z.z, 2.0 * 5 / 4);
+}
+
+TEST(Coordination, WallsHoldGrainsButAreNotPairs) {
+  // A column 0-1-2 between the bottom wall (-1) and the top wall (-2); grain 3 in the corner of
+  // the bottom and left (-3) walls; grain 4 on the bottom wall only.
+  const std::vector<ContactImpulse> c = {pair(-1, 0, 2), pair(0, 1, 2),   pair(1, 2, 2),
+                                         pair(-2, 2, 2), pair(-1, 3, 1),  pair(-3, 3, 1),
+                                         pair(-1, 4, 1), pair(-1, 4, 0.5)};
+  const auto z = coordination(c, 5);
+  EXPECT_EQ(z.wall_contacts, 5);
+  EXPECT_EQ(z.grains, 4);  // 0, 1, 2 and the corner grain 3 (two walls, no pair)
+  EXPECT_EQ(z.rattlers, 1);
+  EXPECT_EQ(z.pairs, 2);
+  EXPECT_DOUBLE_EQ(z.z, 1.0);
+  // Without the walls every grain of the column is a rattler in turn.
+  const auto bare = coordination(c, 5, {1e-6, false});
+  EXPECT_EQ(bare.grains, 0);
+  EXPECT_EQ(bare.z, 0.0);
+}
+
+TEST(Coordination, ThresholdAndSignsOfImpulses) {
+  // Pair 0-1 carries a large impulse; 1-2 only round-off (1e-9 relative); 0-2 sums to a negative
+  // (opening) impulse; 2-3 nodes cancel. Only 0-1 is a contact, so everyone is a rattler.
+  const std::vector<ContactImpulse> c = {pair(0, 1, 1.0), pair(1, 2, 1e-9), pair(0, 2, -0.2),
+                                         pair(2, 3, 0.5), pair(2, 3, -0.5)};
+  const auto z = coordination(c, 4);
+  EXPECT_EQ(z.all_pairs, 1);
+  EXPECT_EQ(z.grains, 0);
+  EXPECT_EQ(z.z, 0.0);
+  // A looser relative threshold keeps 1-2 (then 0-1-2 is a chain, still all rattlers).
+  EXPECT_EQ(coordination(c, 4, {1e-12}).all_pairs, 2);
+  EXPECT_EQ(coordination({}, 5).z, 0.0);
+}
+
+TEST(Coordination, FromAContactProblem) {
+  contact::Problem<2> pb;
+  pb.slots.resize(4);
+  pb.slots[0].grain = 0;
+  pb.slots[1].grain = 1;
+  pb.slots[2].grain = 1;
+  pb.slots[3].grain = 2;
+  contact::Contact<2> c;
+  c.a = 0;
+  c.b = 1;
+  c.normal = Vec<2>(1, 0);
+  c.impulse = Vec<2>(2.0, 0.5);
+  pb.contacts.push_back(c);
+  c.a = -1;
+  c.wall = 2;
+  c.b = 3;
+  c.normal = Vec<2>(0, 1);
+  c.impulse = Vec<2>(0.0, -1.0);
+  pb.contacts.push_back(c);
+  const auto ci = contact_impulses(pb);
+  ASSERT_EQ(ci.size(), 2u);
+  EXPECT_EQ(ci[0].a, 0);
+  EXPECT_EQ(ci[0].b, 1);
+  EXPECT_DOUBLE_EQ(ci[0].normal_impulse, 2.0);
+  EXPECT_EQ(ci[1].a, -3);
+  EXPECT_EQ(ci[1].b, 2);
+  EXPECT_DOUBLE_EQ(ci[1].normal_impulse, -1.0);
+}
+
+TEST(TimeSeries, ReadsColumnsAndRefusesGarbage) {
+  const auto dir = std::filesystem::temp_directory_path() / "mpmcd_unit_analysis";
+  std::filesystem::create_directories(dir);
+  const auto good = (dir / "good.csv").string();
+  std::ofstream(good) << "time,phi\n0,0.7\n1e-3,7.5e-1\n";
+  const auto ts = read_time_series(good);
+  EXPECT_EQ(ts.rows(), 2u);
+  EXPECT_EQ(ts.column("phi")[1], 0.75);
+  EXPECT_TRUE(ts.has("time"));
+  EXPECT_THROW((void)ts.column("Z"), InputError);
+  const auto bad = (dir / "bad.csv").string();
+  std::ofstream(bad) << "time,phi\n0,abc\n";
+  EXPECT_THROW(read_time_series(bad), InputError);
+  std::ofstream(bad) << "time,phi\n0\n";
+  EXPECT_THROW(read_time_series(bad), InputError);
+  EXPECT_THROW(read_time_series((dir / "none.csv").string()), InputError);
+}

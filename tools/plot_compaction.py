@@ -1,0 +1,90 @@
+#!/usr/bin/python3
+"""Plots of the paper's Figures 4 and 5 from the CSV files written by `mpmcd analyze`.
+
+Usage: plot_compaction.py <analysis-folder>
+Reads figure4.csv, figure5.csv and compaction_fit.csv there and writes figure4.png (eps and
+ln(Vs/Vs0) versus Phi) and figure5.png (sigma/M_p of the bottom wall versus Phi with the fitted
+eq. (10)); one colour per run, legend by lambda (docs/observables.md).
+"""
+import csv
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def read(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    return rows
+
+
+def column(rows, name, run):
+    return np.array([float(r[name]) if r[name] != "" else np.nan for r in rows if r["run"] == run])
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    folder = sys.argv[1]
+    fits = read(os.path.join(folder, "compaction_fit.csv"))
+    fig4 = read(os.path.join(folder, "figure4.csv"))
+    fig5 = read(os.path.join(folder, "figure5.csv"))
+    lambdas = [float(f["lambda"]) for f in fits]
+    labels = {}
+    for f in fits:
+        lam = float(f["lambda"])
+        label = f"λ = {lam / 1e6:g} MPa"
+        if lambdas.count(lam) > 1:
+            label += f" ({os.path.basename(os.path.normpath(f['folder']))})"
+        labels[f["run"]] = label
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+
+    # Figure 4: eps (solid) and ln(Vs/Vs0) (dashed) versus Phi.
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for k, f in enumerate(fits):
+        run, c = f["run"], colours[k % len(colours)]
+        phi = column(fig4, "phi", run)
+        ax.plot(phi, column(fig4, "eps", run), "-", color=c, label=f"ε, {labels[run]}")
+        ax.plot(phi, column(fig4, "ln_Vs_Vs0", run), "--", color=c,
+                label=f"ln(Vs/Vs0), {labels[run]}")
+        if f["phi_J"]:
+            ax.axvline(float(f["phi_J"]), color=c, lw=0.6, ls=":")
+    ax.set_xlabel("Φ")
+    ax.set_ylabel("ε,  ln(Vs/Vs0)")
+    ax.set_title("Figure 4: vertical strain and grain volume change")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(folder, "figure4.png"), dpi=130)
+    plt.close(fig)
+
+    # Figure 5: sigma/M_p versus Phi, fitted eq. (10) as a line over the fitted range.
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for k, f in enumerate(fits):
+        run, c = f["run"], colours[k % len(colours)]
+        phi = column(fig5, "phi", run)
+        y = column(fig5, "sigma_over_Mp", run)
+        model = column(fig5, "model", run)
+        ax.plot(phi, y, ".", ms=2.5, color=c, label=f"{labels[run]}")
+        if f["c1"]:
+            ok = np.isfinite(model)
+            ax.plot(phi[ok], model[ok], "-", color="k" if len(fits) == 1 else c, lw=1.2,
+                    label=f"eq. (10): c1 = {float(f['c1']):.3g} ± {float(f['c1_error']):.1g}, "
+                          f"c2 = {float(f['c2']):.3g} ± {float(f['c2_error']):.1g}")
+    ax.set_xlabel("Φ")
+    ax.set_ylabel("σ / M_p (bottom wall, < 0 in compression)")
+    ax.set_title("Figure 5: wall stress and the compaction law (10)")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(folder, "figure5.png"), dpi=130)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()
