@@ -41,6 +41,9 @@ int run_cli(int argc, char** argv) {
   run->add_option("-o,--output", run_opt.output_dir, "output folder (overrides [output] folder)");
   run->add_option("-t,--threads", run_opt.threads, "OpenMP threads (overrides [simulation])")
       ->check(CLI::Range(1, 1024));
+  run->add_option("--scheme", run_opt.scheme,
+                  "with mpirun: partition (default) or master (docs/parallel.md)")
+      ->check(CLI::IsMember({"partition", "master"}));
 
   std::string check_input;
   auto* check = cli.add_subcommand("check", "validate an input file and exit");

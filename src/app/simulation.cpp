@@ -17,6 +17,7 @@
 #include "mpmcd/packing/input.hpp"
 #include "mpmcd/packing/packing.hpp"
 #include "mpmcd/packing/seeding.hpp"
+#include "mpmcd/parallel/distribute.hpp"
 #include "mpmcd/points/seeding.hpp"
 #include "mpmcd/version.hpp"
 
@@ -307,7 +308,8 @@ class Outputs {
     csv_ << extra << "\n";
     csv_.flush();
   }
-  void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver, double t) {
+  void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
+           const contact::Problem<2>& problem, double t) {
     if (!pvd_) return;
     const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
     write_points_vtu(model, (fs::path(dir_) / name).string());
@@ -317,7 +319,7 @@ class Outputs {
           fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
       const std::string pname =
           fmt::format("{}_pairs_{:06d}.csv", cfg_.simulation.name, vtu_count_);
-      write_contacts(model, solver, (fs::path(dir_) / cname).string(),
+      write_contacts(model, problem, (fs::path(dir_) / cname).string(),
                      (fs::path(dir_) / pname).string());
       if (!contacts_pvd_)
         contacts_pvd_ = std::make_unique<io::PvdSeries>(
@@ -328,9 +330,8 @@ class Outputs {
   }
   // Contacts as points at their nodes (normal, impulses, the two bodies; walls as -1 - index),
   // and the per-pair aggregated contact force sum P / dt as a CSV.
-  void write_contacts(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
+  void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& pb,
                       const std::string& vtu_path, const std::string& csv_path) {
-    const auto& pb = solver.contact_problem();
     io::VtuPointCloud vtu(pb.contacts.size());
     auto& normal = vtu.add_array("normal", 3);
     auto& pn = vtu.add_array("normal_impulse", 1);
@@ -394,9 +395,25 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
     summary.output_dir =
         (fs::path(cfg.source_path).parent_path() / summary.output_dir).lexically_normal().string();
   const CompactionObserver observer(cfg, model);
-  Outputs out(cfg, summary.output_dir, observer.csv_header());
+  // Processes (docs/parallel.md): every rank holds the model and computes its grains; rank 0
+  // gathers the state at output times and writes every file.
+  const auto& comm = parallel::Comm::world();
+  const bool root = comm.rank() == 0;
+  if (!root) log().set_level(spdlog::level::off);  // rank 0 reports
   mpm::ImplicitSolver<2> solver(model.grid, settings, model.points, model.grains, model.law_ptrs());
   solver.set_boundary_conditions(build_boundaries(cfg, model.grid, 0.0));
+  const parallel::Scheme scheme =
+      parallel::scheme_from_string(opt.scheme.empty() ? "partition" : opt.scheme);
+  if (comm.size() > 1)
+    solver.set_distribution(
+        &comm, parallel::deal_grains(model.points, model.grains, scheme, comm.size()), scheme);
+  std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
+  if (root) out_ptr = std::make_unique<Outputs>(cfg, summary.output_dir, observer.csv_header());
+  const bool stop_active = cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0;
+  const auto gather_state = [&](int to) {
+    ScopedStage ts(&solver.timers(), "output");
+    parallel::gather_points(comm, model.points, model.grains, solver.owner(), to);
+  };
 
   log().info("mpmcd {} ({}): {} grains, {} material points, grid {}x{} cells of {} m, {} threads",
              kVersion, kGitHash, model.grains.size(), model.points.size(), model.grid.cells()[0],
@@ -408,13 +425,19 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
   mpm::StepStats last;
   auto record = [&](bool force) {
     const double eps = 1e-9 * dt_nominal;
-    if (force || t >= next_csv - eps) {
-      out.csv_row(summary.steps, t, dt, last, mpm::diagnostics(model),
-                  observer.csv_fields(model, last, solver.contact_problem(), t));
+    const bool csv = force || t >= next_csv - eps, vtu = force || t >= next_vtu - eps;
+    if (!csv && !vtu) return;
+    if (comm.size() > 1) gather_state(0);
+    ScopedStage ts(&solver.timers(), "output");
+    const auto problem = parallel::gather_contacts(comm, solver.contact_problem(), 0);
+    if (csv) {
+      if (root)
+        out_ptr->csv_row(summary.steps, t, dt, last, mpm::diagnostics(model),
+                         observer.csv_fields(model, last, problem, t));
       next_csv = t + cfg.output.csv_interval;
     }
-    if (force || t >= next_vtu - eps) {
-      out.vtu(model, solver, t);
+    if (vtu) {
+      if (root) out_ptr->vtu(model, solver, problem, t);
       next_vtu = t + cfg.output.vtu_interval;
     }
   };
@@ -430,7 +453,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
       ++summary.failed_steps;
       const double dt_new = dt_try * cfg.time.cut_factor;
       if (!st.retryable || dt_new < cfg.time.dt_min) {
-        const std::string saved = out.last_good(model);
+        if (comm.size() > 1) gather_state(0);
+        const std::string saved = root ? out_ptr->last_good(model) : std::string();
         log().error("last good state (t = {:.9g} s) written to {}", t, saved);
         throw NumericalError(st.retryable ? fmt::format("{}; dt cut down to dt_min = {:.3g} s "
                                                         "did not help",
@@ -454,6 +478,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
       good_since_cut = 0;
       log().info("dt restored to {:.4g} s at t = {:.9g} s", dt, t);
     }
+    if (stop_active && comm.size() > 1) gather_state(-1);  // Phi needs every grain's area
     const auto stop = observer.stop_reason(model, st, t);  // [stop] criteria
     record(stop || t >= t_end - 1e-9 * dt_nominal);
     if (stop) {
@@ -480,6 +505,19 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
     timers += fmt::format(" {} {:.2f} s", name, secs);
   log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,
              summary.failed_steps, t, summary.wall_seconds, timers);
+  // Per-stage timers over ranks with the serial shares (docs/parallel.md): <name>_timers.csv.
+  std::vector<double> bytes{static_cast<double>(comm.bytes_sent())};
+  comm.sum(bytes);
+  const auto report = parallel::stage_report(comm, solver.timers().totals());
+  const std::string csv = parallel::stage_report_csv(
+      report, summary.wall_seconds, comm.size(), omp_get_max_threads(), summary.steps,
+      bytes[0] / comm.size() / std::max<std::int64_t>(summary.steps, 1));
+  if (root) {
+    io::write_file_atomic(
+        (fs::path(summary.output_dir) / (cfg.simulation.name + "_timers.csv")).string(), csv);
+    log().info("{} rank(s), scheme {}: timers in {}_timers.csv", comm.size(),
+               parallel::to_string(scheme), cfg.simulation.name);
+  }
   log().info("outputs in {}", summary.output_dir);
   return summary;
 }

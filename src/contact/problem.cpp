@@ -107,6 +107,59 @@ void free_velocity(const Problem<Dim>& p, const std::vector<Vec<Dim>>& v, const 
 }  // namespace
 
 template <int Dim>
+void error_terms(const Problem<Dim>& p, double& num, double& den) {
+  const auto v = slot_velocities(p);
+  num = 0;
+  den = 0;
+  for (const auto& c : p.contacts) {
+    Vec<Dim> u;
+    Mat<Dim> W;
+    free_velocity(p, v, c, u, W);
+    const Vec<Dim> loc = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
+    num += (loc - c.impulse).squaredNorm();
+    den += c.impulse.squaredNorm();
+  }
+}
+
+template <int Dim>
+GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings,
+                            const ErrorReduce& reduce) {
+  const auto global_error = [&]() {
+    double num = 0, den = 0;
+    error_terms(p, num, den);
+    reduce(num, den);
+    return num == 0.0 ? 0.0 : std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
+  };
+  GsResult r;
+  r.error = global_error();
+  if (r.error <= settings.tolerance) {
+    r.converged = true;
+    return r;
+  }
+  auto v = slot_velocities(p);
+  while (r.sweeps < settings.max_sweeps) {
+    for (auto& c : p.contacts) {
+      Vec<Dim> u;
+      Mat<Dim> W;
+      free_velocity(p, v, c, u, W);
+      const Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
+      const Vec<Dim> dP = P - c.impulse;
+      if (dP == Vec<Dim>::Zero()) continue;
+      respond(p, v, c.b, dP);
+      if (c.a >= 0) respond(p, v, c.a, Vec<Dim>(-dP));
+      c.impulse = P;
+    }
+    ++r.sweeps;
+    r.error = global_error();
+    if (r.error <= settings.tolerance) {
+      r.converged = true;
+      break;
+    }
+  }
+  return r;
+}
+
+template <int Dim>
 double error(const Problem<Dim>& p) {
   const auto v = slot_velocities(p);
   double num = 0, den = 0;
@@ -287,6 +340,8 @@ Problem<Dim> read_problem(const std::string& path) {
   template Vec<D> local_solution<D>(const Vec<D>&, const Mat<D>&, const Vec<D>&, double, double); \
   template double error<D>(const Problem<D>&);                                                    \
   template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&);                        \
+  template void error_terms<D>(const Problem<D>&, double&, double&);                              \
+  template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&, const ErrorReduce&);    \
   template void write_problem<D>(const Problem<D>&, const std::string&);                          \
   template Problem<D> read_problem<D>(const std::string&);
 MPMCD_INSTANTIATE(2)

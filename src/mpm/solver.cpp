@@ -591,6 +591,18 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     work_.clear();
     for (std::size_t g = 0; g < ng; ++g) work_.push_back(std::make_unique<GrainWork>());
   }
+  // The grains this rank computes (all of them when serial); ghosts are added by exchange_entries.
+  const bool dist = distributed();
+  if (owner_.size() != ng) owner_.assign(ng, 0);
+  owned_.clear();
+  role_.assign(ng, 0);
+  for (std::size_t g = 0; g < ng; ++g)
+    if (!dist || owner_[g] == comm_->rank()) {
+      owned_.push_back(g);
+      role_[g] = 1;
+    }
+  local_ = owned_;
+  const std::size_t no = owned_.size();
   F_trial_.resize(np);
   sigma_trial_.resize(np);
   dF_inv_T_.resize(np);
@@ -600,20 +612,23 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   history_trial_ = points_.history;
   const bool linear = settings_.shape == grid::ShapeKind::kLinear;
   auto collect_failure = [&]() {
-    for (std::size_t g = 0; g < ng; ++g)
+    bool failed = false;
+    for (std::size_t g : owned_)
       if (!work_[g]->failure.empty()) {
         stats.failure = work_[g]->failure;
         stats.grain = static_cast<std::int64_t>(g);
         stats.point = work_[g]->fail_point;
         stats.retryable = work_[g]->retryable;
-        return true;
+        failed = true;
+        break;
       }
-    return false;
+    return dist ? sync_failure(stats) : failed;
   };
   {
     ScopedStage t(&timers_, "p2g");
-#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
-    for (std::size_t g = 0; g < ng; ++g) {
+#pragma omp parallel for schedule(dynamic, 1) if (no > 1)
+    for (std::size_t i = 0; i < no; ++i) {
+      const std::size_t g = owned_[i];
       if (linear)
         setup_grain<grid::Linear1D>(g, dt);
       else
@@ -622,19 +637,31 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   }
   if (collect_failure()) return stats;
   const bool contact = settings_.contact.enabled;
+  if (contact && dist) {
+    ScopedStage t(&timers_, "comm.entries");
+    exchange_entries();
+  }
   if (contact) {
     ScopedStage t(&timers_, "contact.detect");
     detect_contacts(dt);
+    if (dist) {
+      ScopedStage tc(&timers_, "contact.detect.comm");
+      exchange_requests();
+    } else {
+      have_contacts_ = !problem_.contacts.empty();
+    }
   } else {
     problem_.contacts.clear();
     problem_.slots.clear();
+    have_contacts_ = false;
   }
   double impulse_change = 0, ref_scale = 0, vel_scale = 0;
   for (int it = 0; it <= settings_.max_iterations; ++it) {
     {
       ScopedStage t(&timers_, "newton.assemble");
-#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
-      for (std::size_t g = 0; g < ng; ++g) {
+#pragma omp parallel for schedule(dynamic, 1) if (no > 1)
+      for (std::size_t i = 0; i < no; ++i) {
+        const std::size_t g = owned_[i];
         GrainWork& w = *work_[g];
         if (w.converged || !w.failure.empty()) continue;
         if (linear)
@@ -648,14 +675,21 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     // Convergence of each evaluated grain: |R| <= tol * reference and |dv|_M <= tol * velocity
     // scale, the references floored at 1e-3 of the largest grain's so that a grain at rest (whose
     // own scales vanish) is judged on the scale of the step, not on round-off.
-    for (std::size_t g = 0; g < ng; ++g) {
+    for (std::size_t g : owned_) {
       if (!work_[g]->evaluated) continue;
       ref_scale = std::max(ref_scale, work_[g]->res_ref);
       vel_scale = std::max(vel_scale, work_[g]->vel_ref);
     }
+    if (dist) {  // max is exact: the same scales as one process
+      ScopedStage tc(&timers_, "newton.check.comm");
+      std::vector<double> sc{ref_scale, vel_scale};
+      comm_->max(sc);
+      ref_scale = sc[0];
+      vel_scale = sc[1];
+    }
     double worst = 0;
     bool all = true;
-    for (std::size_t g = 0; g < ng; ++g) {
+    for (std::size_t g : owned_) {
       GrainWork& w = *work_[g];
       if (w.evaluated) {
         w.evaluated = false;
@@ -670,11 +704,18 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       }
       all = all && w.converged;
     }
+    if (dist) {
+      ScopedStage tc(&timers_, "newton.check.comm");
+      std::vector<double> r{worst, all ? 0.0 : 1.0};
+      comm_->max(r);
+      worst = r[0];
+      all = r[1] == 0.0;
+    }
     stats.residual_history.push_back(worst);
     // Staggered with Newton: the step has converged when the grains have (with the current
     // impulses) and the impulses have stopped changing (method.md §4).
-    const bool impulses_ok = problem_.contacts.empty() ||
-                             (it > 0 && impulse_change <= settings_.contact.impulse_tolerance);
+    const bool impulses_ok =
+        !have_contacts_ || (it > 0 && impulse_change <= settings_.contact.impulse_tolerance);
     if (all && impulses_ok) {
       stats.converged = true;
       break;
@@ -682,8 +723,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     if (it == settings_.max_iterations) break;
     {
       ScopedStage t(&timers_, "newton.solve");
-#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
-      for (std::size_t g = 0; g < ng; ++g) {
+#pragma omp parallel for schedule(dynamic, 1) if (no > 1)
+      for (std::size_t i = 0; i < no; ++i) {
+        const std::size_t g = owned_[i];
         GrainWork& w = *work_[g];
         if (w.converged || !w.failure.empty()) continue;
         if (!w.tangent_current) {
@@ -696,26 +738,33 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       }
     }
     if (collect_failure()) return stats;
-    if (!problem_.contacts.empty()) {
+    if (have_contacts_) {
       ScopedStage t(&timers_, "contact.solve");
-      impulse_change = update_contacts(stats);
+      impulse_change = dist ? update_contacts_distributed(stats) : update_contacts(stats);
     }
   }
-  for (std::size_t g = 0; g < ng; ++g) {
+  for (std::size_t g : owned_) {
     stats.iterations = std::max(stats.iterations, work_[g]->iterations);
     stats.linear_solves += work_[g]->solves;
   }
   if (!stats.converged) {
-    for (std::size_t g = 0; g < ng; ++g)
+    for (std::size_t g : owned_)
       if (!work_[g]->converged) {
         stats.grain = static_cast<std::int64_t>(g);
         break;
       }
+    if (dist) {
+      ScopedStage tc(&timers_, "newton.check.comm");
+      std::vector<std::int64_t> gmin{stats.grain < 0 ? std::numeric_limits<std::int64_t>::max()
+                                                     : stats.grain};
+      comm_->min(gmin);
+      stats.grain = gmin[0] == std::numeric_limits<std::int64_t>::max() ? -1 : gmin[0];
+    }
     stats.failure =
         fmt::format("Newton did not converge in {} iterations (relative residual {:.3e}",
                     settings_.max_iterations,
                     stats.residual_history.empty() ? 0.0 : stats.residual_history.back());
-    if (!problem_.contacts.empty())
+    if (have_contacts_)
       stats.failure += fmt::format(", relative impulse change {:.3e}, Gauss-Seidel error {:.3e}",
                                    impulse_change, stats.gs_error);
     stats.failure += ")";
@@ -731,6 +780,22 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       for (int d = 0; d < Dim; ++d) stats.wall_force[c.wall][d] -= c.impulse[d] / dt;
     const std::int32_t a = c.a < 0 ? -1 - c.wall : problem_.slots[c.a].grain;
     previous_.push_back({problem_.slots[c.b].node, a, problem_.slots[c.b].grain, c.impulse});
+  }
+  if (dist) {  // sums over the ranks' contacts, added in rank order
+    ScopedStage tc(&timers_, "newton.check.comm");
+    std::vector<std::int64_t> n{stats.contacts, stats.active_contacts, stats.linear_solves};
+    comm_->sum(n);
+    std::vector<std::int64_t> it{-stats.iterations};
+    comm_->min(it);
+    stats.contacts = n[0];
+    stats.active_contacts = n[1];
+    stats.linear_solves = n[2];
+    stats.iterations = static_cast<int>(-it[0]);
+    std::vector<double> f;
+    for (const auto& wf : stats.wall_force) f.insert(f.end(), wf.begin(), wf.end());
+    comm_->sum(f);
+    for (std::size_t k = 0; k < stats.wall_force.size(); ++k)
+      for (int d = 0; d < 3; ++d) stats.wall_force[k][d] = f[3 * k + d];
   }
   std::sort(previous_.begin(), previous_.end(), [](const PrevImpulse& x, const PrevImpulse& y) {
     return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
@@ -794,7 +859,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   };
   std::vector<Entry> entries;
   std::vector<std::int64_t> shared;
-  for (std::size_t g = 0; g < work_.size(); ++g) {
+  for (std::size_t g : local_) {
     const GrainWork& w = *work_[g];
     for (std::size_t a = 0; a < w.m.size(); ++a) {
       if (w.m[a] < w.contact_mass) continue;
@@ -809,8 +874,21 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
       node_head_[n] = static_cast<std::int32_t>(entries.size()) - 1;
     }
   }
+  // The rank solving the contacts at node n (docs/parallel.md): the owner of the lowest grain with
+  // a field there (partition) or rank 0 (master); every rank sees all the fields at its nodes.
+  const bool dist = distributed();
+  const int me = dist ? comm_->rank() : 0;
+  const auto node_rank = [&](std::int64_t n) {
+    if (!dist) return 0;
+    if (scheme_ == parallel::Scheme::kMaster) return 0;
+    std::int32_t gmin = std::numeric_limits<std::int32_t>::max();
+    for (std::int32_t e = node_head_[n]; e >= 0; e = entries[e].next)
+      gmin = std::min(gmin, entries[e].g);
+    return owner_[gmin];
+  };
   // 2. Grain-grain contacts: every pair of fields at a shared node (three grains: three pairs).
-  for (std::int64_t n : shared)
+  for (std::int64_t n : shared) {
+    if (node_rank(n) != me) continue;
     for (std::int32_t e1 = node_head_[n]; e1 >= 0; e1 = entries[e1].next)
       for (std::int32_t e2 = entries[e1].next; e2 >= 0; e2 = entries[e2].next) {
         Entry A = entries[e1], B = entries[e2];
@@ -855,13 +933,15 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         c.impulse = warm(n, A.g, B.g);
         problem_.contacts.push_back(c);
       }
+  }
   // 3. Grain-wall contacts: grain nodes within wall_range cells of a wall; gap from the points.
   for (std::size_t wi = 0; wi < cs.walls.size(); ++wi) {
     const Wall<Dim>& wall = cs.walls[wi];
-    for (std::size_t g = 0; g < work_.size(); ++g) {
+    for (std::size_t g : local_) {
       const GrainWork& w = *work_[g];
       for (std::size_t a = 0; a < w.m.size(); ++a) {
         if (w.m[a] < w.contact_mass) continue;
+        if (dist && node_rank(w.node_global[a]) != me) continue;
         const Vec<Dim> xn = grid_.node_position(grid_.node_coords(w.node_global[a]));
         if (wall.distance(xn, time_) > cs.wall_range * h) continue;
         double gap = std::numeric_limits<double>::infinity(), ext = 0;
@@ -904,6 +984,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   // Compliance groups: one per grain with contact slots when its linear solver is direct.
   for (auto& w : work_) w->slots.clear();
   problem_.groups.clear();
+  if (dist) return;  // lumped operator only (set_distribution)
   if (cs.grain_compliance && settings_.linear_solver != LinearSolverKind::kCg) {
     for (std::size_t s = 0; s < slot_ref_.size(); ++s)
       work_[slot_ref_[s].first]->slots.push_back(static_cast<std::int32_t>(s));
@@ -1077,10 +1158,11 @@ template <int Dim>
 void ImplicitSolver<Dim>::commit() {
   if (!step_ready_) throw std::logic_error("ImplicitSolver::commit without a converged step");
   ScopedStage t(&timers_, "g2p");
-  const std::size_t ng = grains_.size();
+  const std::size_t no = owned_.size();
   const bool linear = settings_.shape == grid::ShapeKind::kLinear;
-#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
-  for (std::size_t g = 0; g < ng; ++g) {
+#pragma omp parallel for schedule(dynamic, 1) if (no > 1)
+  for (std::size_t i = 0; i < no; ++i) {
+    const std::size_t g = owned_[i];
     if (linear)
       commit_grain<grid::Linear1D>(g);
     else
@@ -1103,6 +1185,359 @@ Vec<Dim> ImplicitSolver<Dim>::field_momentum(std::size_t g) const {
   const GrainWork& w = *work_.at(g);
   for (std::size_t a = 0; a < w.m.size(); ++a) p += w.m[a] * w.v[a];
   return p;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Distributed step (docs/parallel.md).
+
+namespace {
+template <class T>
+T take(parallel::Buffer& b) {
+  return b.get<T>();
+}
+}  // namespace
+
+template <int Dim>
+void ImplicitSolver<Dim>::set_distribution(const parallel::Comm* comm, std::vector<int> owner,
+                                           parallel::Scheme scheme) {
+  if (owner.size() != grains_.size())
+    throw std::invalid_argument("ImplicitSolver::set_distribution: one owner per grain");
+  comm_ = comm;
+  owner_ = std::move(owner);
+  scheme_ = scheme;
+  if (distributed() && settings_.contact.enabled && settings_.contact.grain_compliance &&
+      settings_.linear_solver != LinearSolverKind::kCg)
+    throw InputError("", 0, "contact.delassus",
+                     "the grain compliance operator couples all contacts of a grain and is not "
+                     "available on more than one rank yet: use delassus = \"lumped\" (or run on "
+                     "one rank)");
+}
+
+template <int Dim>
+bool ImplicitSolver<Dim>::sync_failure(StepStats& stats) {
+  // The lowest failing grain over all ranks, its message from its owner.
+  ScopedStage tc(&timers_, "newton.check.comm");
+  constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
+  std::vector<std::int64_t> g{stats.failure.empty() ? kNone : stats.grain};
+  comm_->min(g);
+  if (g[0] == kNone) return false;
+  const int root = owner_[static_cast<std::size_t>(g[0])];
+  parallel::Buffer b;
+  if (comm_->rank() == root) {
+    b.put(stats.point);
+    b.put(static_cast<std::int32_t>(stats.retryable));
+    b.bytes().insert(b.bytes().end(), stats.failure.begin(), stats.failure.end());
+  }
+  comm_->broadcast(b.bytes(), root);
+  stats.grain = g[0];
+  stats.point = take<std::int64_t>(b);
+  stats.retryable = take<std::int32_t>(b) != 0;
+  const std::size_t head = sizeof(std::int64_t) + sizeof(std::int32_t);
+  stats.failure.assign(b.bytes().begin() + static_cast<std::ptrdiff_t>(head), b.bytes().end());
+  return true;
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::exchange_entries() {
+  // 1. Node boxes of every grain (each rank sends its own: a few integers per grain).
+  const int me = comm_->rank(), np = comm_->size();
+  const std::size_t ng = grains_.size();
+  const ContactSettings<Dim>& cs = settings_.contact;
+  const double h = grid_.cell_size();
+  parallel::Buffer mine;
+  for (std::size_t g : owned_) {
+    const GrainWork& w = *work_[g];
+    mine.put(static_cast<std::int32_t>(g));
+    std::array<std::int64_t, 2 * Dim> box;
+    for (int d = 0; d < Dim; ++d) {
+      box[d] = grains_[g].size() > 0 ? w.box_lo[d] : 0;
+      box[Dim + d] = grains_[g].size() > 0 ? w.box_lo[d] + w.box_n[d] - 1 : -1;
+    }
+    mine.put(box);
+  }
+  const auto all = comm_->allgather(mine.bytes());
+  boxes_.assign(ng, {});
+  for (int r = 0; r < np; ++r) {
+    parallel::Buffer b;
+    b.bytes() = all[r];
+    while (!b.done()) {
+      const auto g = take<std::int32_t>(b);
+      boxes_[g] = take<std::array<std::int64_t, 2 * Dim>>(b);
+    }
+  }
+  const auto overlap = [&](std::size_t g1, std::size_t g2) {
+    for (int d = 0; d < Dim; ++d)
+      if (boxes_[g1][d] > boxes_[g2][Dim + d] || boxes_[g2][d] > boxes_[g1][Dim + d]) return false;
+    return true;
+  };
+  const auto inside = [&](std::size_t g, const IVec<Dim>& c) {
+    for (int d = 0; d < Dim; ++d)
+      if (c[d] < boxes_[g][d] || c[d] > boxes_[g][Dim + d]) return false;
+    return true;
+  };
+  // 2. Neighbours (symmetric): ranks owning a grain whose box meets one of mine (partition); the
+  // master and every other rank (master).
+  const bool master = scheme_ == parallel::Scheme::kMaster;
+  std::vector<std::vector<std::size_t>> near(ng);  // owned grain -> grains whose boxes meet it
+  std::vector<char> is_nb(static_cast<std::size_t>(np), 0);
+  for (std::size_t g : owned_)
+    for (std::size_t g2 = 0; g2 < ng; ++g2) {
+      if (g2 == g || !overlap(g, g2)) continue;
+      if (master || owner_[g2] != me) near[g].push_back(g2);
+      if (!master && owner_[g2] != me) is_nb[owner_[g2]] = 1;
+    }
+  if (master)
+    for (int r = 0; r < np; ++r) is_nb[r] = me == 0 ? r != 0 : r == 0;
+  neighbours_.clear();
+  for (int r = 0; r < np; ++r)
+    if (is_nb[r]) neighbours_.push_back(r);
+  // 3. Each owned grain's contact-capable nodes (mass above the threshold) that another rank may
+  // need: inside the box of a grain owned there (partition); inside any other grain's box or
+  // within wall range (master, to rank 0). Sent with the points touching them (x, F).
+  std::map<int, parallel::Buffer> out;
+  for (int r : neighbours_) out[r];
+  std::vector<std::int32_t> sel, pts;
+  std::vector<char> dest(static_cast<std::size_t>(np));
+  for (std::size_t g : owned_) {
+    const GrainWork& w = *work_[g];
+    if (master && me == 0) break;
+    for (int r : neighbours_) {
+      sel.clear();
+      for (std::size_t a = 0; a < w.m.size(); ++a) {
+        if (w.m[a] < w.contact_mass) continue;
+        const IVec<Dim> c = w.node_box[a] + w.box_lo;
+        bool send = false;
+        for (std::size_t g2 : near[g])
+          if ((master || owner_[g2] == r) && inside(g2, c)) {
+            send = true;
+            break;
+          }
+        if (!send && master) {
+          const Vec<Dim> xn = grid_.node_position(c);
+          for (const auto& wall : cs.walls)
+            if (wall.distance(xn, time_) <= cs.wall_range * h) send = true;
+        }
+        if (send) sel.push_back(static_cast<std::int32_t>(a));
+      }
+      if (sel.empty()) continue;
+      parallel::Buffer& b = out[r];
+      b.put(static_cast<std::int32_t>(g));
+      b.put(w.contact_mass);
+      b.put(static_cast<std::int32_t>(sel.size()));
+      pts.clear();
+      for (std::int32_t a : sel) {
+        b.put(w.node_global[a]);
+        b.put(w.m[a]);
+        b.put(w.grad_m[a]);
+        b.put(static_cast<std::int32_t>(w.node_pts_start[a + 1] - w.node_pts_start[a]));
+        for (std::int32_t k = w.node_pts_start[a]; k < w.node_pts_start[a + 1]; ++k) {
+          b.put(w.node_pts[k]);
+          pts.push_back(w.node_pts[k]);
+        }
+      }
+      std::sort(pts.begin(), pts.end());
+      pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+      b.put(static_cast<std::int32_t>(pts.size()));
+      for (std::int32_t i : pts) {
+        const std::int64_t p = grains_[g].begin + i;
+        b.put(i);
+        b.put(points_.x[p]);
+        b.put(points_.F[p]);
+      }
+    }
+  }
+  auto in = comm_->exchange(out, neighbours_);
+  // 4. Ghost grains: their sent nodes as a field of this rank (mass, mass gradient, points).
+  for (auto& [r, b] : in) {
+    while (!b.done()) {
+      const auto g = static_cast<std::size_t>(take<std::int32_t>(b));
+      GrainWork& w = *work_[g];
+      role_[g] = 2;
+      w.contact_mass = take<double>(b);
+      const auto k = static_cast<std::size_t>(take<std::int32_t>(b));
+      w.m.resize(k);
+      w.grad_m.resize(k);
+      w.node_global.resize(k);
+      w.node_pts_start.assign(k + 1, 0);
+      w.node_pts.clear();
+      for (std::size_t a = 0; a < k; ++a) {
+        w.node_global[a] = take<std::int64_t>(b);
+        w.m[a] = take<double>(b);
+        w.grad_m[a] = take<Vec<Dim>>(b);
+        const auto npts = take<std::int32_t>(b);
+        for (std::int32_t j = 0; j < npts; ++j) w.node_pts.push_back(take<std::int32_t>(b));
+        w.node_pts_start[a + 1] = static_cast<std::int32_t>(w.node_pts.size());
+      }
+      const auto npts = take<std::int32_t>(b);
+      for (std::int32_t j = 0; j < npts; ++j) {
+        const std::int64_t p = grains_[g].begin + take<std::int32_t>(b);
+        points_.x[p] = take<Vec<Dim>>(b);
+        points_.F[p] = take<Mat<Dim>>(b);
+      }
+      w.v.assign(k, Vec<Dim>::Zero());
+      w.P.assign(k, Vec<Dim>::Zero());
+      w.mask.assign(k, 0);
+    }
+  }
+  local_.clear();
+  for (std::size_t g = 0; g < ng; ++g)
+    if (role_[g]) local_.push_back(g);
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::exchange_requests() {
+  // The slots of ghost grains in this rank's contacts: ask their owners for their velocities
+  // every iteration, and hand them the warm-start impulse (owners then serve those slots).
+  std::vector<std::int64_t> count{static_cast<std::int64_t>(problem_.contacts.size())};
+  comm_->sum(count);
+  have_contacts_ = count[0] > 0;
+  links_.clear();
+  std::map<int, parallel::Buffer> out;
+  for (int r : neighbours_) {
+    links_[r];
+    out[r];
+  }
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
+    const auto [g, a] = slot_ref_[s];
+    if (role_[g] != 2) continue;
+    const int r = owner_[g];
+    links_.at(r).ask.push_back(static_cast<std::int32_t>(s));
+    parallel::Buffer& b = out.at(r);
+    b.put(g);
+    b.put(work_[g]->node_global[a]);
+    b.put(work_[g]->P[a]);
+  }
+  auto in = comm_->exchange(out, neighbours_);
+  for (auto& [r, b] : in) {
+    Link& link = links_.at(r);
+    while (!b.done()) {
+      const auto g = take<std::int32_t>(b);
+      const auto node = take<std::int64_t>(b);
+      const Vec<Dim> P = take<Vec<Dim>>(b);
+      GrainWork& w = *work_[g];
+      const IVec<Dim> c = grid_.node_coords(node) - w.box_lo;
+      std::int64_t idx = 0, stride = 1;
+      for (int d = 0; d < Dim; ++d) {
+        idx += c[d] * stride;
+        stride *= w.box_n[d];
+      }
+      const std::int32_t a = w.box_to_active[static_cast<std::size_t>(idx)];
+      w.P[a] = P;
+      link.serve.emplace_back(g, a);
+    }
+  }
+}
+
+template <int Dim>
+double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
+  // 1. Velocities of the ghost slots from their owners (boundary data, neighbours only).
+  {
+    ScopedStage tc(&timers_, "contact.solve.comm");
+    std::map<int, parallel::Buffer> out;
+    for (const auto& [r, link] : links_) {
+      parallel::Buffer& b = out[r];
+      for (const auto& [g, a] : link.serve) b.put(work_[g]->v[a]);
+    }
+    auto in = comm_->exchange(out, neighbours_);
+    for (const auto& [r, link] : links_) {
+      parallel::Buffer& b = in.at(r);
+      for (std::int32_t s : link.ask) {
+        const auto [g, a] = slot_ref_[s];
+        work_[g]->v[a] = take<Vec<Dim>>(b);
+      }
+    }
+  }
+  // 2. Free velocities (lumped operator) of this rank's slots, as in update_contacts.
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
+    const GrainWork& w = *work_[slot_ref_[s].first];
+    const std::int32_t a = slot_ref_[s].second;
+    auto& slot = problem_.slots[s];
+    slot.mass = w.m[a];
+    slot.v_free = w.v[a] - w.P[a] / w.m[a];
+  }
+  std::vector<Vec<Dim>> old(problem_.contacts.size());
+  for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
+  // 3. Gauss-Seidel: each rank on its nodes' contacts (no slot is shared between ranks), the
+  // error summed over ranks before every test (partition); all contacts on rank 0 (master).
+  contact::GsResult r;
+  if (scheme_ == parallel::Scheme::kPartition) {
+    const contact::ErrorReduce reduce = [&](double& num, double& den) {
+      ScopedStage tc(&timers_, "contact.solve.comm");
+      std::vector<double> v{num, den};
+      comm_->sum(v);
+      num = v[0];
+      den = v[1];
+    };
+    ScopedStage t(&timers_, "contact.gs");
+    r = contact::solve_gauss_seidel(problem_, settings_.contact.gs, reduce);
+  } else {
+    r.converged = true;  // ranks other than 0 hold no contact
+    if (comm_->rank() == 0) {
+      ScopedStage t(&timers_, "contact.gs");
+      r = contact::solve_gauss_seidel(problem_, settings_.contact.gs);
+    }
+    ScopedStage tc(&timers_, "contact.solve.comm");
+    std::vector<double> v{static_cast<double>(r.sweeps), r.error, r.converged ? 0.0 : 1.0};
+    comm_->max(v);
+    r.sweeps = static_cast<int>(v[0]);
+    r.error = v[1];
+    r.converged = v[2] == 0.0;
+  }
+  stats.gs_sweeps += r.sweeps;
+  stats.gs_error = r.error;
+  gs_converged_ = r.converged;
+  double num = 0, den = 0;
+  std::vector<Vec<Dim>> slot_p(problem_.slots.size(), Vec<Dim>::Zero());
+  for (std::size_t c = 0; c < old.size(); ++c) {
+    const auto& ct = problem_.contacts[c];
+    num += (ct.impulse - old[c]).squaredNorm();
+    den += ct.impulse.squaredNorm();
+    slot_p[ct.b] += ct.impulse;
+    if (ct.a >= 0) slot_p[ct.a] -= ct.impulse;
+  }
+  // 4. New impulses into the grains: own slots here, ghost slots sent back to their owners.
+  std::vector<double> dv2(work_.size(), -1.0);
+  const auto apply = [&](std::int32_t g, std::int32_t a, const Vec<Dim>& P) {
+    GrainWork& w = *work_[g];
+    if (P == w.P[a]) return;
+    const Vec<Dim> v_free = w.v[a] - w.P[a] / w.m[a];
+    w.P[a] = P;
+    const Vec<Dim> v_new = v_free + P / w.m[a];
+    double& acc = dv2[g];
+    acc = std::max(acc, 0.0) + w.m[a] * (v_new - w.v[a]).squaredNorm();
+    w.v[a] = v_new;
+  };
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
+    if (role_[slot_ref_[s].first] == 1) apply(slot_ref_[s].first, slot_ref_[s].second, slot_p[s]);
+  {
+    ScopedStage tc(&timers_, "contact.solve.comm");
+    std::map<int, parallel::Buffer> out;
+    for (const auto& [rk, link] : links_) {
+      parallel::Buffer& b = out[rk];
+      for (std::int32_t s : link.ask) {
+        b.put(slot_p[s]);
+        work_[slot_ref_[s].first]->P[slot_ref_[s].second] = slot_p[s];
+      }
+    }
+    auto in = comm_->exchange(out, neighbours_);
+    for (const auto& [rk, link] : links_) {
+      parallel::Buffer& b = in.at(rk);
+      for (const auto& [g, a] : link.serve) apply(g, a, take<Vec<Dim>>(b));
+    }
+    std::vector<double> v{num, den};
+    comm_->sum(v);
+    num = v[0];
+    den = v[1];
+  }
+  for (std::size_t g : owned_)
+    if (dv2[g] >= 0.0) {
+      work_[g]->converged = false;
+      work_[g]->solved_once = true;
+      work_[g]->dv_norm = std::sqrt(dv2[g]);
+    }
+  if (num == 0.0) return gs_converged_ ? 0.0 : 1.0;
+  const double change = std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
+  return gs_converged_ ? change : std::max(change, 1.0);
 }
 
 template class ImplicitSolver<2>;

@@ -16,6 +16,7 @@ struct RunOptions {
   bool quiet = false;      ///< no progress lines or info messages
   std::string output_dir;  ///< overrides [output] folder if not empty
   int threads = 0;         ///< overrides [simulation] threads if > 0
+  std::string scheme;      ///< parallel scheme "partition" (default) or "master" (docs/parallel.md)
 };
 
 /// Summary of a finished run.

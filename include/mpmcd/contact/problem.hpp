@@ -3,6 +3,7 @@
 /// solver with the lumped Delassus operator, the nonlinear Gauss-Seidel over all contacts, and the
 /// one error measure shared by the solver and the tests. It can be written to a file and replayed.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,22 @@ double error(const Problem<Dim>& problem);
 /// `problem`.
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& problem, const GsSettings& settings);
+
+/// Sums (num, den) of error(problem) = sqrt(num) / sqrt(den) over every part of a problem that is
+/// split between processes (docs/parallel.md); the identity for a whole problem.
+using ErrorReduce = std::function<void(double& num, double& den)>;
+
+/// The two sums of error(problem): num = sum_c |P_c - local_c(P)|^2, den = sum_c |P_c|^2 [(N s)^2].
+template <int Dim>
+void error_terms(const Problem<Dim>& problem, double& num, double& den);
+
+/// Gauss-Seidel on this process's part of a distributed problem (docs/parallel.md): the same sweeps
+/// as solve_gauss_seidel over the local contacts, with the error summed over all parts by `reduce`
+/// before every test, so that every process does the same number of sweeps. The parts must not
+/// share slots (contacts coupled through a slot are solved by one process).
+template <int Dim>
+GsResult solve_gauss_seidel(Problem<Dim>& problem, const GsSettings& settings,
+                            const ErrorReduce& reduce);
 
 /// Writes the problem as text (one line per slot and contact, 17 significant digits).
 template <int Dim>

@@ -3,6 +3,7 @@
 /// nodal velocities with the consistent tangent, per-grain sparse linear solves, G2P on commit.
 #include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +14,8 @@
 #include "mpmcd/grid/grid.hpp"
 #include "mpmcd/grid/shape.hpp"
 #include "mpmcd/materials/law.hpp"
+#include "mpmcd/parallel/comm.hpp"
+#include "mpmcd/parallel/partition.hpp"
 #include "mpmcd/points/point_set.hpp"
 
 namespace mpmcd::mpm {
@@ -128,6 +131,16 @@ class ImplicitSolver {
 
   /// Replaces the nodal velocity boundary conditions (later sets override earlier ones).
   void set_boundary_conditions(const std::vector<VelocityBC<Dim>>& bcs);
+  /// Runs the steps on several processes (docs/parallel.md): this rank computes the grains g with
+  /// owner[g] == comm.rank() (their points must be current here; others' may be stale); contacts
+  /// at a node are solved by the rank owning the node's lowest grain (kPartition) or by rank 0
+  /// (kMaster). Needs the lumped Delassus operator when comm has more than one rank.
+  void set_distribution(const parallel::Comm* comm, std::vector<int> owner,
+                        parallel::Scheme scheme);
+  /// Rank computing each grain (all 0 when serial).
+  const std::vector<int>& owner() const { return owner_; }
+  /// True when the step runs on more than one rank.
+  bool distributed() const { return comm_ != nullptr && comm_->size() > 1; }
   /// Sets the time t^n [s] of the next step (wall positions).
   void set_time(double t) { time_ = t; }
   /// The contact problem of the last step (impulses solved), for output and replay.
@@ -163,6 +176,10 @@ class ImplicitSolver {
   void detect_contacts(double dt);
   double update_contacts(StepStats& stats);
   std::int32_t slot_of(std::int32_t g, std::int32_t a);
+  bool sync_failure(StepStats& stats);
+  void exchange_entries();
+  void exchange_requests();
+  double update_contacts_distributed(StepStats& stats);
   template <class S1>
   void commit_grain(std::size_t g);
 
@@ -194,6 +211,22 @@ class ImplicitSolver {
     Vec<Dim> impulse;
   };
   std::vector<PrevImpulse> previous_;  // sorted by (node, a, b)
+  // Distribution (docs/parallel.md): owner rank per grain, this rank's grains, ghost grains (their
+  // contact nodes received from their owners), the neighbour ranks and, per neighbour, the slots
+  // whose velocity / impulse travel each Newton iteration.
+  const parallel::Comm* comm_ = nullptr;
+  parallel::Scheme scheme_ = parallel::Scheme::kPartition;
+  std::vector<int> owner_;
+  std::vector<std::size_t> owned_, local_;  // owned grains; owned + ghost grains (ascending)
+  std::vector<std::uint8_t> role_;          // per grain: 0 absent, 1 owned, 2 ghost
+  std::vector<int> neighbours_;
+  std::vector<std::array<std::int64_t, 2 * Dim>> boxes_;  // node box lo, hi (inclusive) per grain
+  struct Link {
+    std::vector<std::pair<std::int32_t, std::int32_t>> serve;  // my (grain, active) asked for
+    std::vector<std::int32_t> ask;  // my problem's ghost slots owned there, in request order
+  };
+  std::map<int, Link> links_;
+  bool have_contacts_ = false;  // some rank has contacts this step
   double time_ = 0.0;
   double dt_ = 0.0;
   bool step_ready_ = false;

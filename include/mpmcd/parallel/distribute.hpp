@@ -1,0 +1,56 @@
+#pragma once
+/// Whole-model operations of a distributed run (docs/parallel.md): dealing the grains of a model,
+/// gathering the committed point state of every grain on one rank (outputs), and the per-stage
+/// timer report with the serial share of each stage.
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mpmcd/contact/problem.hpp"
+#include "mpmcd/parallel/comm.hpp"
+#include "mpmcd/parallel/partition.hpp"
+#include "mpmcd/points/point_set.hpp"
+
+namespace mpmcd::parallel {
+
+/// Rank of each grain: bisection of the centroids weighted by point count (kPartition) or greedy
+/// dealing by volume (kMaster), over comm.size() ranks; the same on every rank.
+template <int Dim>
+std::vector<int> deal_grains(const points::PointSet<Dim>& points,
+                             const std::vector<points::Grain>& grains, Scheme scheme, int ranks);
+
+/// Copies the committed state (x, v, F, sigma, sigma_zz, volume, history) of every grain from its
+/// owner to rank `root` (root < 0: to every rank). Output-time traffic, not per step.
+template <int Dim>
+void gather_points(const Comm& comm, points::PointSet<Dim>& points,
+                   const std::vector<points::Grain>& grains, const std::vector<int>& owner,
+                   int root);
+
+/// Every rank's contacts merged on rank `root` in the canonical order (node of B, body A, grain
+/// B; walls as -1 - index), with one slot per contact side carrying its grain and node: the same
+/// problem whatever the rank count (outputs, Z). Other ranks get an empty problem.
+template <int Dim>
+contact::Problem<Dim> gather_contacts(const Comm& comm, const contact::Problem<Dim>& local,
+                                      int root);
+
+/// One stage of the timer report, over ranks [s].
+struct StageTime {
+  std::string name;         ///< stage name (".comm" suffix: communication inside that stage)
+  double max = 0;           ///< largest time over ranks [s]
+  double mean = 0;          ///< mean over ranks [s]
+  double min = 0;           ///< smallest over ranks [s]
+  double serial = 0;        ///< work done by one rank alone: max - second largest of work [s]
+  bool nested = false;      ///< inside another stage (not added to the step total)
+  bool one_thread = false;  ///< runs on one thread per rank
+};
+
+/// Gathers every rank's stage totals [s] and derives the report (collective call).
+std::vector<StageTime> stage_report(const Comm& comm, const std::map<std::string, double>& totals);
+
+/// The report as CSV: stage,max_s,mean_s,min_s,work_serial_s,nested,one_thread, then summary
+/// rows (wall, serial fraction of one rank, one-thread share, bytes sent per rank per step).
+std::string stage_report_csv(const std::vector<StageTime>& rows, double wall_seconds, int ranks,
+                             int threads, long long steps, double bytes_per_rank_step);
+
+}  // namespace mpmcd::parallel
