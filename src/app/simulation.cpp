@@ -356,7 +356,8 @@ class Outputs {
       gap[i] = c.gap;
       body_a[i] = c.a >= 0 ? pb.slots[c.a].grain : -1 - c.wall;
       body_b[i] = sb.grain;
-      pairs[{body_a[i], body_b[i]}] += c.impulse * inv_dt;
+      // try_emplace with zero: a default-constructed Eigen vector is uninitialised.
+      pairs.try_emplace({body_a[i], body_b[i]}, Vec<2>::Zero()).first->second += c.impulse * inv_dt;
     }
     vtu.write(vtu_path);
     std::string text = "body_a,body_b,force_x,force_y\n";
