@@ -44,6 +44,10 @@ int run_cli(int argc, char** argv) {
   run->add_option("--scheme", run_opt.scheme,
                   "with mpirun: partition (default) or master (docs/parallel.md)")
       ->check(CLI::IsMember({"partition", "master"}));
+  run->add_option("--rebalance", run_opt.rebalance,
+                  "with mpirun, partition: re-deal the grains when the work imbalance max/mean "
+                  "exceeds this, checked every 50 steps (0: never; default 1.1)")
+      ->check(CLI::NonNegativeNumber);
 
   std::string check_input;
   auto* check = cli.add_subcommand("check", "validate an input file and exit");

@@ -471,6 +471,19 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
     }
     solver.commit();
     last = st;
+    if (comm.size() > 1 && scheme == parallel::Scheme::kPartition && opt.rebalance > 0 &&
+        (summary.steps + 1) % 50 == 0) {  // docs/parallel.md: deterministic work weights
+      ScopedStage ts(&solver.timers(), "rebalance");
+      auto owner = solver.owner();
+      bool moved = false;
+      const double imbalance = parallel::rebalance(comm, model.points, model.grains, owner,
+                                                   solver.take_grain_work(), opt.rebalance, moved);
+      if (moved) {
+        solver.set_distribution(&comm, owner, scheme);
+        log().info("step {}: work imbalance {:.3f} > {}: grains dealt again", summary.steps + 1,
+                   imbalance, opt.rebalance);
+      }
+    }
     t += dt_try;
     ++summary.steps;
     summary.newton_iterations += st.iterations;

@@ -743,9 +743,11 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       impulse_change = dist ? update_contacts_distributed(stats) : update_contacts(stats);
     }
   }
+  grain_work_.resize(ng, 0.0);
   for (std::size_t g : owned_) {
     stats.iterations = std::max(stats.iterations, work_[g]->iterations);
     stats.linear_solves += work_[g]->solves;
+    grain_work_[g] += static_cast<double>(grains_[g].size()) * (1 + work_[g]->iterations);
   }
   if (!stats.converged) {
     for (std::size_t g : owned_)
@@ -1211,6 +1213,14 @@ void ImplicitSolver<Dim>::set_distribution(const parallel::Comm* comm, std::vect
                      "the grain compliance operator couples all contacts of a grain and is not "
                      "available on more than one rank yet: use delassus = \"lumped\" (or run on "
                      "one rank)");
+}
+
+template <int Dim>
+std::vector<double> ImplicitSolver<Dim>::take_grain_work() {
+  std::vector<double> w(grains_.size(), 0.0);
+  grain_work_.resize(grains_.size(), 0.0);
+  w.swap(grain_work_);
+  return w;
 }
 
 template <int Dim>

@@ -167,6 +167,85 @@ contact::Problem<Dim> gather_contacts(const Comm& comm, const contact::Problem<D
 template contact::Problem<2> gather_contacts<2>(const Comm&, const contact::Problem<2>&, int);
 template contact::Problem<3> gather_contacts<3>(const Comm&, const contact::Problem<3>&, int);
 
+namespace {
+// Appends / reads the committed state of grain g (x, v, F, sigma, sigma_zz, volume, history).
+template <int Dim>
+void put_grain(Buffer& b, const points::PointSet<Dim>& points,
+               const std::vector<points::Grain>& grains, std::size_t g) {
+  const std::int64_t h1 = g + 1 < grains.size() ? grains[g + 1].history_offset
+                                                : static_cast<std::int64_t>(points.history.size());
+  for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
+    b.put(points.x[p]);
+    b.put(points.v[p]);
+    b.put(points.F[p]);
+    b.put(points.sigma[p]);
+    b.put(points.sigma_zz[p]);
+    b.put(points.volume[p]);
+  }
+  for (std::int64_t k = grains[g].history_offset; k < h1; ++k) b.put(points.history[k]);
+}
+template <int Dim>
+void get_grain(Buffer& b, points::PointSet<Dim>& points, const std::vector<points::Grain>& grains,
+               std::size_t g) {
+  const std::int64_t h1 = g + 1 < grains.size() ? grains[g + 1].history_offset
+                                                : static_cast<std::int64_t>(points.history.size());
+  for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
+    points.x[p] = b.template get<Vec<Dim>>();
+    points.v[p] = b.template get<Vec<Dim>>();
+    points.F[p] = b.template get<Mat<Dim>>();
+    points.sigma[p] = b.template get<Mat<Dim>>();
+    points.sigma_zz[p] = b.template get<double>();
+    points.volume[p] = b.template get<double>();
+  }
+  for (std::int64_t k = grains[g].history_offset; k < h1; ++k)
+    points.history[k] = b.template get<double>();
+}
+}  // namespace
+
+template <int Dim>
+double rebalance(const Comm& comm, points::PointSet<Dim>& points,
+                 const std::vector<points::Grain>& grains, std::vector<int>& owner,
+                 const std::vector<double>& weights, double threshold, bool& moved) {
+  moved = false;
+  const std::size_t ng = grains.size();
+  // Weights and centroids of every grain (each rank fills its own; sums in rank order).
+  std::vector<double> data(3 * ng, 0.0);
+  for (std::size_t g = 0; g < ng; ++g) {
+    if (owner[g] != comm.rank()) continue;
+    data[g] = weights[g];
+    for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p)
+      for (int d = 0; d < std::min(Dim, 2); ++d) data[ng + 2 * g + d] += points.x[p][d];
+    for (int d = 0; d < 2; ++d)
+      data[ng + 2 * g + d] /= static_cast<double>(std::max<std::int64_t>(grains[g].size(), 1));
+  }
+  comm.sum(data);
+  const std::vector<double> w(data.begin(), data.begin() + static_cast<std::ptrdiff_t>(ng));
+  const double before = imbalance(owner, w, comm.size());
+  if (before <= threshold || comm.size() == 1) return before;
+  std::vector<std::array<double, 2>> c(ng);
+  for (std::size_t g = 0; g < ng; ++g) c[g] = {data[ng + 2 * g], data[ng + 2 * g + 1]};
+  const std::vector<int> next = bisection(c, w, comm.size());
+  std::map<int, Buffer> out;
+  std::set<int> from;
+  for (std::size_t g = 0; g < ng; ++g) {
+    if (next[g] == owner[g]) continue;
+    if (owner[g] == comm.rank()) put_grain(out[next[g]], points, grains, g);
+    if (next[g] == comm.rank()) from.insert(owner[g]);
+  }
+  auto in = comm.exchange(out, std::vector<int>(from.begin(), from.end()));
+  for (std::size_t g = 0; g < ng; ++g)
+    if (next[g] != owner[g] && next[g] == comm.rank())
+      get_grain(in.at(owner[g]), points, grains, g);
+  moved = next != owner;
+  owner = next;
+  return before;
+}
+
+template double rebalance<2>(const Comm&, points::PointSet<2>&, const std::vector<points::Grain>&,
+                             std::vector<int>&, const std::vector<double>&, double, bool&);
+template double rebalance<3>(const Comm&, points::PointSet<3>&, const std::vector<points::Grain>&,
+                             std::vector<int>&, const std::vector<double>&, double, bool&);
+
 std::vector<StageTime> stage_report(const Comm& comm, const std::map<std::string, double>& totals) {
   // Every rank's totals, as "name\0value" records.
   Buffer mine;

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """tests/mpi: the tiny compaction on 1 rank (no mpirun), 2 ranks twice (partition) and 2 ranks
-(master). Checks: same observables (Phi, eps, wall stresses, contacts, Z) on 1 and 2 ranks within
+(master), 2 ranks re-dealing the grains every 50 steps. Checks: same observables (Phi, eps, wall stresses, contacts, Z) on 1 and 2 ranks within
 the contact tolerance, 2-rank runs bitwise identical run to run, the same files written, and the
 timer CSV. Usage: check_compaction_mpi.py MPMCD_BINARY MPIEXEC INPUT WORKDIR"""
 import csv, filecmp, os, subprocess, sys
@@ -9,9 +9,9 @@ binary, mpiexec, toml, work = sys.argv[1:5]
 RTOL = 1e-6  # relative; the Gauss-Seidel tolerance is 1e-8 and the impulse tolerance 1e-6
 
 
-def run(name, ranks, scheme="partition"):
+def run(name, ranks, scheme="partition", extra=()):
     out = os.path.join(work, name)
-    cmd = [binary, "run", toml, "-q", "-t", "1", "-o", out, "--scheme", scheme]
+    cmd = [binary, "run", toml, "-q", "-t", "1", "-o", out, "--scheme", scheme, *extra]
     if ranks > 1:
         cmd = [mpiexec, "--oversubscribe", "--allow-run-as-root", "-np", str(ranks)] + cmd
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
@@ -29,9 +29,11 @@ serial = run("np1", 1)
 two_a = run("np2_a", 2)
 two_b = run("np2_b", 2)
 master = run("np2_master", 2, "master")
+moving = run("np2_rebalance", 2, extra=("--rebalance", "1.000001"))  # re-deals every 50 steps
 ref = rows(serial)
 fail = []
-for name, folder in [("2 ranks", two_a), ("2 ranks master", master)]:
+for name, folder in [("2 ranks", two_a), ("2 ranks master", master),
+                     ("2 ranks re-balanced", moving)]:
     other = rows(folder)
     if len(other) != len(ref):
         fail.append(f"{name}: {len(other)} rows, 1 rank {len(ref)}")

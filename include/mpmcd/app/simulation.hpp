@@ -17,6 +17,7 @@ struct RunOptions {
   std::string output_dir;  ///< overrides [output] folder if not empty
   int threads = 0;         ///< overrides [simulation] threads if > 0
   std::string scheme;      ///< parallel scheme "partition" (default) or "master" (docs/parallel.md)
+  double rebalance = 1.1;  ///< partition: re-deal above this work imbalance max/mean (0: never) [-]
 };
 
 /// Summary of a finished run.

@@ -139,6 +139,9 @@ class ImplicitSolver {
                         parallel::Scheme scheme);
   /// Rank computing each grain (all 0 when serial).
   const std::vector<int>& owner() const { return owner_; }
+  /// Work of each grain computed here since the last call, points x Newton iterations summed over
+  /// steps (0 for grains of other ranks); deterministic, for re-balancing. Resets the counts.
+  std::vector<double> take_grain_work();
   /// True when the step runs on more than one rank.
   bool distributed() const { return comm_ != nullptr && comm_->size() > 1; }
   /// Sets the time t^n [s] of the next step (wall positions).
@@ -226,7 +229,8 @@ class ImplicitSolver {
     std::vector<std::int32_t> ask;  // my problem's ghost slots owned there, in request order
   };
   std::map<int, Link> links_;
-  bool have_contacts_ = false;  // some rank has contacts this step
+  bool have_contacts_ = false;      // some rank has contacts this step
+  std::vector<double> grain_work_;  // points x Newton iterations per grain since take_grain_work
   double time_ = 0.0;
   double dt_ = 0.0;
   bool step_ready_ = false;

@@ -34,6 +34,16 @@ template <int Dim>
 contact::Problem<Dim> gather_contacts(const Comm& comm, const contact::Problem<Dim>& local,
                                       int root);
 
+/// Re-balancing of the partition scheme: with `weights` the work of each owned grain since the
+/// last call (0 for others; deterministic, e.g. points x Newton iterations), the imbalance
+/// max/mean of the ranks' sums; above `threshold` the grains are bisected again at their current
+/// centroids with those weights, and each grain whose rank changes is sent (committed state) from
+/// its old to its new owner. Collective; returns the imbalance measured before [-].
+template <int Dim>
+double rebalance(const Comm& comm, points::PointSet<Dim>& points,
+                 const std::vector<points::Grain>& grains, std::vector<int>& owner,
+                 const std::vector<double>& weights, double threshold, bool& moved);
+
 /// One stage of the timer report, over ranks [s].
 struct StageTime {
   std::string name;         ///< stage name (".comm" suffix: communication inside that stage)

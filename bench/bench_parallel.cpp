@@ -1,0 +1,165 @@
+// Scaling of the parallel step (docs/parallel.md) on the 300-grain compaction slice of
+// bench_contact (DEM packing at phi = 0.78, d in [0.8, 1.2] mm, h = d/8, 2x2 points per cell, four
+// walls, the top one down at 2 m/s, dt = 0.1 us, lumped Delassus operator): `warmup` steps, then
+// `steps` timed ones. Not a Google Benchmark (it runs under mpirun); rank 0 appends one CSV row:
+//   mpirun -np 2 build/release/bench/bench_parallel --scheme partition --threads 1 --csv out.csv
+// tools/scaling.py runs it over ranks, threads and both schemes.
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include "mpmcd/materials/law.hpp"
+#include "mpmcd/mpm/model.hpp"
+#include "mpmcd/mpm/solver.hpp"
+#include "mpmcd/packing/packing.hpp"
+#include "mpmcd/packing/seeding.hpp"
+#include "mpmcd/parallel/distribute.hpp"
+
+using namespace mpmcd;
+
+namespace {
+
+struct Setup {
+  mpm::Model<2> model;
+  std::vector<mpm::Wall<2>> walls;
+};
+
+Setup make_packing() {
+  packing::PackingParams pp;
+  pp.count = 300;
+  pp.diameter_min = 0.8e-3;
+  pp.diameter_max = 1.2e-3;
+  pp.target_phi = 0.78;
+  pp.seed = 42;
+  const packing::Packing pk = packing::generate_packing(pp);
+  Setup s;
+  const double h = packing::mean_diameter(pk) / 8;
+  const Vec<2> origin(pk.xmin - 2 * h, pk.ymin - 2 * h);
+  const IVec<2> cells(static_cast<std::int64_t>((pk.xmax - pk.xmin) / h) + 5,
+                      static_cast<std::int64_t>((pk.ymax - pk.ymin) / h) + 5);
+  s.model.grid = grid::Grid<2>(origin, h, cells);
+  s.model.add_material(materials::make_law<2>("neo_hookean", {{"lambda", 3e6}, {"mu", 1.5e6}}),
+                       990.0);
+  const auto seeded = packing::seed_packing(pk, origin, h, 2);
+  for (std::size_t k = 0; k < pk.disks.size(); ++k) {
+    points::Seeds<2> seeds;
+    seeds.x.assign(seeded.x.begin() + seeded.offset[k], seeded.x.begin() + seeded.offset[k + 1]);
+    seeds.volume.assign(seeded.volume.begin() + seeded.offset[k],
+                        seeded.volume.begin() + seeded.offset[k + 1]);
+    s.model.add_grain(seeds, 0, 0.25 * h, {});
+  }
+  s.walls = {{"bottom", Vec<2>(0, pk.ymin), Vec<2>(0, 1), Vec<2>::Zero(), 0.0},
+             {"top", Vec<2>(0, pk.ymax), Vec<2>(0, -1), Vec<2>(0, -2.0), 0.0},
+             {"left", Vec<2>(pk.xmin, 0), Vec<2>(1, 0), Vec<2>::Zero(), 0.0},
+             {"right", Vec<2>(pk.xmax, 0), Vec<2>(-1, 0), Vec<2>::Zero(), 0.0}};
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scheme_name = "partition", csv;
+  int threads = 1, warmup = 50, steps = 50;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string k = argv[i], v = argv[i + 1];
+    if (k == "--scheme")
+      scheme_name = v;
+    else if (k == "--threads")
+      threads = std::stoi(v);
+    else if (k == "--warmup")
+      warmup = std::stoi(v);
+    else if (k == "--steps")
+      steps = std::stoi(v);
+    else if (k == "--csv")
+      csv = v;
+    else {
+      std::cerr << "unknown option " << k << "\n";
+      return 2;
+    }
+  }
+  const auto& comm = parallel::Comm::world();
+  omp_set_num_threads(threads);
+  const auto scheme = parallel::scheme_from_string(scheme_name);
+  Setup setup = make_packing();
+  auto& model = setup.model;
+  mpm::Settings<2> s;
+  s.theta = 1.0;
+  s.linear_solver = mpm::LinearSolverKind::kCg;
+  s.contact.enabled = true;
+  s.contact.grain_compliance = false;
+  s.contact.walls = setup.walls;
+  mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
+  if (comm.size() > 1)
+    solver.set_distribution(
+        &comm, parallel::deal_grains(model.points, model.grains, scheme, comm.size()), scheme);
+  const double dt = 1e-7;
+  int step = 0;
+  double contacts = 0, sweeps = 0, iters = 0;
+  std::int64_t bytes0 = 0;
+  std::chrono::steady_clock::time_point t0;
+  for (; step < warmup + steps; ++step) {
+    if (step == warmup) {
+      comm.barrier();
+      solver.timers().clear();
+      bytes0 = comm.bytes_sent();
+      t0 = std::chrono::steady_clock::now();
+    }
+    solver.set_time(step * dt);
+    const auto st = solver.solve_step(dt);
+    if (!st.converged) {
+      if (comm.rank() == 0) std::cerr << "step " << step << ": " << st.failure << "\n";
+      parallel::Comm::finalize();
+      return 3;
+    }
+    solver.commit();
+    if (step >= warmup) {
+      contacts += static_cast<double>(st.contacts);
+      sweeps += static_cast<double>(st.gs_sweeps);
+      iters += st.iterations;
+    }
+  }
+  comm.barrier();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::vector<double> bytes{static_cast<double>(comm.bytes_sent() - bytes0)};
+  std::vector<double> bytes_max = bytes;
+  comm.sum(bytes);
+  comm.max(bytes_max);
+  const auto rows = parallel::stage_report(comm, solver.timers().totals());
+  const std::string report = parallel::stage_report_csv(rows, wall, comm.size(), threads, steps,
+                                                        bytes[0] / comm.size() / steps);
+  if (comm.rank() == 0) {
+    // One row: configuration, step time, serial shares, traffic, then per stage (ms per step):
+    // mean time and work done by one rank alone.
+    double serial = 0, one = 0;
+    std::string stages;
+    for (const auto& r : rows) {
+      if (!r.nested) serial += r.serial;
+      if (!r.nested && r.one_thread && threads > 1) one += r.mean;
+      stages +=
+          fmt::format(",{}={:.4f}/{:.4f}", r.name, 1e3 * r.mean / steps, 1e3 * r.serial / steps);
+    }
+    const std::string line =
+        fmt::format("{},{},{},{},{},{:.4f},{:.5f},{:.5f},{:.1f},{:.1f},{:.1f},{:.2f},{:.2f}{}\n",
+                    scheme_name, comm.size(), threads, model.points.size(), steps,
+                    1e3 * wall / steps, serial / wall, one / wall, bytes[0] / comm.size() / steps,
+                    bytes_max[0] / steps, contacts / steps, sweeps / steps, iters / steps, stages);
+    std::cout << report << line;
+    if (!csv.empty()) {
+      const bool fresh = !std::filesystem::exists(csv);
+      std::ofstream out(csv, std::ios::app);
+      if (fresh)
+        out << "scheme,ranks,threads,points,steps,step_ms,serial_fraction,one_thread_fraction,"
+               "bytes_per_rank_step,bytes_max_rank_step,contacts,gs_sweeps,newton_it,stages\n";
+      out << line;
+    }
+  }
+  parallel::Comm::finalize();
+  return 0;
+}
