@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev libomp-dev
   python3 python3-matplotlib python3-numpy
+  libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,137 @@
+#!/usr/bin/python3
+"""Scaling benchmark of the parallel step (docs/parallel.md): runs bench/bench_parallel (the
+300-grain compaction slice) on 1, 2, 4, 8 ranks (oversubscribed where cores are short) for both
+schemes and on 1 rank with 2 threads, then writes to the output folder
+  scaling_runs.csv     one row per run (bench_parallel's row: step time, serial fraction, bytes)
+  speedup.csv          scheme, ranks, threads, step_ms, speedup, efficiency, and the work-based
+                       speedup (serial step / largest rank's work per step: the step time of a
+                       machine where no rank waits for a core; a shared, loaded machine inflates
+                       the measured wall time, not this)
+  serial_stages.csv    per scheme and rank count: per-stage mean time and one-rank-alone time [ms/step]
+  bytes.csv            bytes sent per rank per step (mean and largest rank), per scheme and ranks
+  amdahl.csv           Amdahl projection S(P) = 1 / (f + (1 - f) / P) to P = 60 from the measured
+                       serial fraction f at 2 ranks, both schemes
+  scaling.png          speedup against processes (measured, ideal, Amdahl), like the paper's Fig. 2
+Usage: tools/scaling.py [--build build/release] [--out scaling_out] [--ranks 1 2 4 8]
+                        [--warmup 30] [--steps 50] [--nice 10]"""
+import argparse, csv, os, subprocess, sys
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", default="build/release")
+ap.add_argument("--out", default="scaling_out")
+ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 4, 8])
+ap.add_argument("--threads", type=int, nargs="+", default=[2], help="threads on 1 rank")
+ap.add_argument("--schemes", nargs="+", default=["partition", "master"])
+ap.add_argument("--warmup", type=int, default=30)
+ap.add_argument("--steps", type=int, default=50)
+ap.add_argument("--nice", type=int, default=10)
+ap.add_argument("--plot-only", action="store_true", help="redraw from scaling_runs.csv")
+a = ap.parse_args()
+os.makedirs(a.out, exist_ok=True)
+runs_csv = os.path.join(a.out, "scaling_runs.csv")
+bench = os.path.join(a.build, "bench", "bench_parallel")
+
+
+def run(scheme, ranks, threads):
+    cmd = ["nice", "-n", str(a.nice)]
+    if ranks > 1:
+        cmd += ["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none",
+                "-np", str(ranks)]
+    cmd += [bench, "--scheme", scheme, "--threads", str(threads), "--warmup", str(a.warmup),
+            "--steps", str(a.steps), "--csv", runs_csv]
+    print(" ".join(cmd), flush=True)
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"failed: {r.stderr[-2000:]}")
+    print(r.stdout.strip().splitlines()[-1][:160], flush=True)
+
+
+if not a.plot_only:
+    if os.path.exists(runs_csv):
+        os.remove(runs_csv)
+    for scheme in a.schemes:
+        for ranks in a.ranks:
+            if ranks == 1 and scheme != a.schemes[0]:
+                continue  # one rank: the schemes are the same code path
+            run(scheme, ranks, 1)
+    for t in a.threads:
+        run(a.schemes[0], 1, t)
+
+rows = list(csv.DictReader(open(runs_csv)))
+base = next(r for r in rows if r["ranks"] == "1" and r["threads"] == "1")
+t1 = float(base["step_ms"])
+out = []
+for r in rows:
+    sch = r["scheme"] if r["ranks"] != "1" else "serial"
+    p = int(r["ranks"]) * int(r["threads"])
+    s = t1 / float(r["step_ms"])
+    sw = float(base["work_max_ms"]) / float(r["work_max_ms"])
+    out.append((sch, r["ranks"], r["threads"], r["step_ms"], f"{s:.3f}", f"{s / p:.3f}",
+                r["work_max_ms"], f"{sw:.3f}", f"{sw / p:.3f}"))
+with open(os.path.join(a.out, "speedup.csv"), "w") as f:
+    f.write("scheme,ranks,threads,step_ms,speedup,efficiency,work_max_ms,work_speedup,"
+            "work_efficiency\n")
+    for o in out:
+        f.write(",".join(o) + "\n")
+with open(os.path.join(a.out, "serial_stages.csv"), "w") as f:
+    f.write("scheme,ranks,threads,stage,mean_ms_per_step,one_rank_alone_ms_per_step\n")
+    # The stage column holds name=mean/serial pairs separated by commas after the fixed columns.
+    for line in open(runs_csv).read().splitlines()[1:]:
+        parts = line.split(",")
+        for item in parts[14:]:
+            name, vals = item.split("=")
+            mean, ser = vals.split("/")
+            f.write(f"{parts[0]},{parts[1]},{parts[2]},{name},{mean},{ser}\n")
+with open(os.path.join(a.out, "bytes.csv"), "w") as f:
+    f.write("scheme,ranks,bytes_per_rank_step,bytes_max_rank_step\n")
+    for r in rows:
+        if r["threads"] == "1":
+            f.write(f"{r['scheme']},{r['ranks']},{r['bytes_per_rank_step']},"
+                    f"{r['bytes_max_rank_step']}\n")
+fs = {}
+for r in rows:
+    if r["ranks"] == "2" and r["threads"] == "1":
+        fs[r["scheme"]] = float(r["serial_fraction"])
+P = list(range(1, 61))
+with open(os.path.join(a.out, "amdahl.csv"), "w") as f:
+    f.write("scheme,serial_fraction,S2,S8,S60,E60\n")
+    for sch, fr in fs.items():
+        S = lambda p: 1 / (fr + (1 - fr) / p)
+        f.write(f"{sch},{fr:.4f},{S(2):.2f},{S(8):.2f},{S(60):.2f},{S(60) / 60:.3f}\n")
+print(open(os.path.join(a.out, "speedup.csv")).read())
+print(open(os.path.join(a.out, "bytes.csv")).read())
+print(open(os.path.join(a.out, "amdahl.csv")).read())
+try:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    ax.plot([1, 60], [1, 60], "k-", lw=1, label="ideal")
+    for sch, mark in (("partition", "o"), ("master", "s")):
+        sel = [r for r in rows
+               if r["threads"] == "1" and (r["scheme"] == sch or r["ranks"] == "1")]
+        pts = sorted((int(r["ranks"]), t1 / float(r["step_ms"])) for r in sel)
+        wpts = sorted((int(r["ranks"]), float(base["work_max_ms"]) / float(r["work_max_ms"]))
+                      for r in sel)
+        if len(pts) > 1:
+            ax.plot(*zip(*pts), mark + "-", label=f"{sch}: wall time (shared machine)")
+            ax.plot(*zip(*wpts), mark + ":", mfc="none", label=f"{sch}: largest rank's work")
+        if sch in fs:
+            fr = fs[sch]
+            ax.plot(P, [1 / (fr + (1 - fr) / p) for p in P], "--",
+                    label=f"{sch}: Amdahl, f = {100 * fr:.1f} %")
+    thr = [(int(r["threads"]), t1 / float(r["step_ms"])) for r in rows
+           if r["ranks"] == "1" and r["threads"] != "1"]
+    if thr:
+        ax.plot(*zip(*sorted(thr)), "^", label="1 rank, threads")
+    ax.set_xlabel("processes P")
+    ax.set_ylabel("speedup")
+    ax.set_xlim(0, 61)
+    ax.set_ylim(0, 61)
+    ax.set_title("300-grain compaction slice (cf. paper Fig. 2)")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(a.out, "scaling.png"), dpi=130)
+    print("wrote", os.path.join(a.out, "scaling.png"))
+except ImportError:
+    print("matplotlib missing: no PNG")
