@@ -155,11 +155,11 @@ int main(int argc, char** argv) {
       stages +=
           fmt::format(",{}={:.4f}/{:.4f}", r.name, 1e3 * r.mean / steps, 1e3 * r.serial / steps);
     }
-    const std::string line =
-        fmt::format("{},{},{},{},{},{:.4f},{:.5f},{:.5f},{:.1f},{:.1f},{:.1f},{:.2f},{:.2f}{}\n",
-                    scheme_name, comm.size(), threads, model.points.size(), steps,
-                    1e3 * wall / steps, serial / wall, one / wall, bytes[0] / comm.size() / steps,
-                    bytes_max[0] / steps, contacts / steps, sweeps / steps, iters / steps, stages);
+    const std::string line = fmt::format(
+        "{},{},{},{},{},{:.4f},{:.4f},{:.5f},{:.5f},{:.1f},{:.1f},{:.1f},{:.2f},{:.2f}{}\n",
+        scheme_name, comm.size(), threads, model.points.size(), steps, 1e3 * wall / steps,
+        1e3 * work_max[0] / steps, serial / wall, one / wall, bytes[0] / comm.size() / steps,
+        bytes_max[0] / steps, contacts / steps, sweeps / steps, iters / steps, stages);
     std::cout << report << line;
     if (!csv.empty()) {
       const bool fresh = !std::filesystem::exists(csv);
