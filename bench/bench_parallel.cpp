@@ -3,7 +3,8 @@
 // walls, the top one down at 2 m/s, dt = 0.1 us, lumped Delassus operator): `warmup` steps, then
 // `steps` timed ones. Not a Google Benchmark (it runs under mpirun); rank 0 appends one CSV row:
 //   mpirun -np 2 build/release/bench/bench_parallel --scheme partition --threads 1 --csv out.csv
-// tools/scaling.py runs it over ranks, threads and both schemes.
+// tools/scaling.py runs it over ranks, threads and both schemes. `--cpu-time 1` times the stages
+// in thread CPU time: on a shared, oversubscribed machine a rank's work without its waits.
 #include <fmt/format.h>
 #include <omp.h>
 
@@ -66,7 +67,7 @@ Setup make_packing() {
 
 int main(int argc, char** argv) {
   std::string scheme_name = "partition", csv;
-  int threads = 1, warmup = 50, steps = 50;
+  int threads = 1, warmup = 50, steps = 50, cpu = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
     if (k == "--scheme")
@@ -79,6 +80,8 @@ int main(int argc, char** argv) {
       steps = std::stoi(v);
     else if (k == "--csv")
       csv = v;
+    else if (k == "--cpu-time")
+      cpu = std::stoi(v);
     else {
       std::cerr << "unknown option " << k << "\n";
       return 2;
@@ -99,6 +102,8 @@ int main(int argc, char** argv) {
   if (comm.size() > 1)
     solver.set_distribution(
         &comm, parallel::deal_grains(model.points, model.grains, scheme, comm.size()), scheme);
+  // --cpu-time 1: stage timers in thread CPU time (a rank's work without waiting for a core).
+  solver.timers().set_thread_cpu_time(cpu != 0);
   const double dt = 1e-7;
   int step = 0;
   double contacts = 0, sweeps = 0, iters = 0;

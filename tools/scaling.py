@@ -9,6 +9,8 @@ schemes and on 1 rank with 2 threads, then writes to the output folder
                        the measured wall time, not this)
   serial_stages.csv    per scheme and rank count: per-stage mean time and one-rank-alone time [ms/step]
   bytes.csv            bytes sent per rank per step (mean and largest rank), per scheme and ranks
+  serial_fraction.csv  per scheme and rank count: time per step in which one rank works alone,
+                       and as a fraction of the one-rank step (Amdahl's f)
   amdahl.csv           Amdahl projection S(P) = 1 / (f + (1 - f) / P) to P = 60 from the measured
                        serial fraction f at 2 ranks, both schemes
   scaling.png          speedup against processes (measured, ideal, Amdahl), like the paper's Fig. 2
@@ -25,6 +27,8 @@ ap.add_argument("--schemes", nargs="+", default=["partition", "master"])
 ap.add_argument("--warmup", type=int, default=30)
 ap.add_argument("--steps", type=int, default=50)
 ap.add_argument("--nice", type=int, default=10)
+ap.add_argument("--cpu-time", action="store_true",
+                help="stage timers in thread CPU time (shared machine: work without core waits)")
 ap.add_argument("--plot-only", action="store_true", help="redraw from scaling_runs.csv")
 a = ap.parse_args()
 os.makedirs(a.out, exist_ok=True)
@@ -38,7 +42,7 @@ def run(scheme, ranks, threads):
         cmd += ["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none",
                 "-np", str(ranks)]
     cmd += [bench, "--scheme", scheme, "--threads", str(threads), "--warmup", str(a.warmup),
-            "--steps", str(a.steps), "--csv", runs_csv]
+            "--steps", str(a.steps), "--csv", runs_csv, "--cpu-time", "1" if a.cpu_time else "0"]
     print(" ".join(cmd), flush=True)
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
@@ -88,10 +92,27 @@ with open(os.path.join(a.out, "bytes.csv"), "w") as f:
         if r["threads"] == "1":
             f.write(f"{r['scheme']},{r['ranks']},{r['bytes_per_rank_step']},"
                     f"{r['bytes_max_rank_step']}\n")
+# Amdahl's f = T_alone / T_1: the time per step in which one rank works alone (sum over top-level
+# stages of the largest work minus the second largest) over the one-rank step (work) time.
+alone = {}
+for line in open(runs_csv).read().splitlines()[1:]:
+    parts = line.split(",")
+    ms = 0.0
+    for item in parts[14:]:
+        name, vals = item.split("=")
+        if name.endswith(".comm") or name == "contact.gs":
+            continue  # nested in another stage
+        ms += float(vals.split("/")[1])
+    alone[(parts[0], parts[1], parts[2])] = ms
 fs = {}
 for r in rows:
     if r["ranks"] == "2" and r["threads"] == "1":
-        fs[r["scheme"]] = float(r["serial_fraction"])
+        fs[r["scheme"]] = alone[(r["scheme"], "2", "1")] / float(base["work_max_ms"])
+with open(os.path.join(a.out, "serial_fraction.csv"), "w") as f:
+    f.write("scheme,ranks,one_rank_alone_ms_per_step,serial_fraction_of_1_rank_step\n")
+    for (sch, rk, th), ms in sorted(alone.items()):
+        if th == "1" and rk != "1":
+            f.write(f"{sch},{rk},{ms:.4f},{ms / float(base['work_max_ms']):.4f}\n")
 P = list(range(1, 61))
 with open(os.path.join(a.out, "amdahl.csv"), "w") as f:
     f.write("scheme,serial_fraction,S2,S8,S60,E60\n")
@@ -100,6 +121,7 @@ with open(os.path.join(a.out, "amdahl.csv"), "w") as f:
         f.write(f"{sch},{fr:.4f},{S(2):.2f},{S(8):.2f},{S(60):.2f},{S(60) / 60:.3f}\n")
 print(open(os.path.join(a.out, "speedup.csv")).read())
 print(open(os.path.join(a.out, "bytes.csv")).read())
+print(open(os.path.join(a.out, "serial_fraction.csv")).read())
 print(open(os.path.join(a.out, "amdahl.csv")).read())
 try:
     import matplotlib
