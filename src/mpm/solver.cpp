@@ -889,7 +889,17 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
     return owner_[gmin];
   };
   // 2. Grain-grain contacts: every pair of fields at a shared node (three grains: three pairs).
-  for (std::int64_t n : shared) {
+  // Normals and gaps per node in parallel (threads), then the contacts in the serial order.
+  struct Candidate {
+    Entry A, B;
+    Vec<Dim> normal;
+    double gap;
+  };
+  std::vector<std::vector<Candidate>> found(shared.size());
+  const auto nshared = static_cast<std::int64_t>(shared.size());
+#pragma omp parallel for schedule(dynamic, 32) if (nshared > 256)
+  for (std::int64_t i = 0; i < nshared; ++i) {
+    const std::int64_t n = shared[i];
     if (node_rank(n) != me) continue;
     for (std::int32_t e1 = node_head_[n]; e1 >= 0; e1 = entries[e1].next)
       for (std::int32_t e2 = entries[e1].next; e2 >= 0; e2 = entries[e2].next) {
@@ -926,16 +936,20 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
           }
           gap = std::max(0.0, gap);
         }
-        contact::Contact<Dim> c;
-        c.a = slot_of(A.g, A.a);
-        c.b = slot_of(B.g, B.a);
-        c.normal = normal;
-        c.gap = gap;
-        c.friction = cs.friction[grains_[A.g].material * cs.materials + grains_[B.g].material];
-        c.impulse = warm(n, A.g, B.g);
-        problem_.contacts.push_back(c);
+        found[i].push_back({A, B, normal, gap});
       }
   }
+  for (std::size_t i = 0; i < shared.size(); ++i)
+    for (const Candidate& f : found[i]) {
+      contact::Contact<Dim> c;
+      c.a = slot_of(f.A.g, f.A.a);
+      c.b = slot_of(f.B.g, f.B.a);
+      c.normal = f.normal;
+      c.gap = f.gap;
+      c.friction = cs.friction[grains_[f.A.g].material * cs.materials + grains_[f.B.g].material];
+      c.impulse = warm(shared[i], f.A.g, f.B.g);
+      problem_.contacts.push_back(c);
+    }
   // 3. Grain-wall contacts: grain nodes within wall_range cells of a wall; gap from the points.
   for (std::size_t wi = 0; wi < cs.walls.size(); ++wi) {
     const Wall<Dim>& wall = cs.walls[wi];
