@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <iostream>
 
 #include "mpmcd/app/simulation.hpp"
@@ -41,6 +42,10 @@ int run_cli(int argc, char** argv) {
   run->add_option("--restart", run_opt.restart,
                   "continue from a checkpoint file (<name>_checkpoint_<step>.h5); outputs go on "
                   "in the checkpoint's folder unless -o is given");
+  run->add_option("--stop-after", run_opt.stop_after,
+                  "stop after this many steps (of this invocation) as if interrupted: write a "
+                  "checkpoint and exit 4 (chunks of a long run under a job time limit)")
+      ->check(CLI::PositiveNumber);
   run->add_flag("-q,--quiet", run_opt.quiet, "no progress or info lines");
   run->add_option("-o,--output", run_opt.output_dir, "output folder (overrides [output] folder)");
   run->add_option("-t,--threads", run_opt.threads, "OpenMP threads (overrides [simulation])")
@@ -81,11 +86,15 @@ int run_cli(int argc, char** argv) {
       } else {
         summary = run_simulation(io::load_config(run_input), run_opt);
       }
-      if (summary.signal != 0) {
+      if (summary.interrupted) {
+        const std::string by = summary.signal == SIGINT    ? "SIGINT"
+                               : summary.signal == SIGTERM ? "SIGTERM"
+                               : summary.signal != 0 ? fmt::format("signal {}", summary.signal)
+                                                     : std::string("--stop-after");
         std::cerr << fmt::format(
-            "mpmcd: interrupted at step {} (t = {:.9g} s) by signal {}; state saved in {}\n"
+            "mpmcd: interrupted ({}) at step {} (t = {:.9g} s); state saved in {}\n"
             "mpmcd: resume with: mpmcd run --restart {}\n",
-            summary.steps, summary.time, summary.signal, summary.checkpoint, summary.checkpoint);
+            by, summary.steps, summary.time, summary.checkpoint, summary.checkpoint);
         return static_cast<int>(ExitCode::kInterrupted);
       }
     } else if (*check) {

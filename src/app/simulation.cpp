@@ -729,9 +729,11 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     const bool at_end = t >= t_end - 1e-9 * dt_nominal;
     record(at_end);
     const auto now = std::chrono::steady_clock::now();
-    if (g_signal != 0) {
+    const bool stop = opt.stop_after > 0 && summary.steps - steps0 >= opt.stop_after;
+    if ((g_signal != 0 || stop) && !at_end) {
       summary.signal = g_signal;
-      write_checkpoint("signal");
+      summary.interrupted = true;
+      write_checkpoint(g_signal != 0 ? "signal" : "stop_after");
       break;
     }
     const bool due_steps =
@@ -753,7 +755,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                  summary.steps, t, 100 * t / t_end, st.iterations, rate, eta);
     }
   }
-  if (summary.signal == 0 && cfg.checkpoint.at_end && last_checkpoint_step != summary.steps)
+  if (!summary.interrupted && cfg.checkpoint.at_end && last_checkpoint_step != summary.steps)
     write_checkpoint("end");
   summary.time = t;
   summary.wall_seconds =
@@ -761,9 +763,10 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   std::string timers;
   for (const auto& [name, secs] : solver.timers().totals())
     timers += fmt::format(" {} {:.2f} s", name, secs);
-  if (summary.signal != 0) {
-    log().warn("interrupted by {} at step {} (t = {:.6g} s)", signal_name(summary.signal),
-               summary.steps, t);
+  if (summary.interrupted) {
+    log().warn("stopped ({}) at step {} (t = {:.9g} s)",
+               summary.signal != 0 ? signal_name(summary.signal) : "--stop-after", summary.steps,
+               t);
     return summary;
   }
   log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,

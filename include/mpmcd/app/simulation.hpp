@@ -14,10 +14,12 @@ namespace mpmcd::app {
 
 /// Command-line options of `mpmcd run`.
 struct RunOptions {
-  bool quiet = false;      ///< no progress lines or info messages
-  std::string output_dir;  ///< overrides [output] folder if not empty
-  int threads = 0;         ///< overrides [simulation] threads if > 0
-  std::string restart;     ///< checkpoint to continue from ("" = start at t = 0)
+  bool quiet = false;           ///< no progress lines or info messages
+  std::string output_dir;       ///< overrides [output] folder if not empty
+  int threads = 0;              ///< overrides [simulation] threads if > 0
+  std::string restart;          ///< checkpoint to continue from ("" = start at t = 0)
+  std::int64_t stop_after = 0;  ///< if > 0: stop after this many steps of this invocation, as if
+                                ///< interrupted (checkpoint written; for job time limits, tests)
 };
 
 /// Summary of a finished run.
@@ -29,7 +31,8 @@ struct RunSummary {
   double wall_seconds = 0;             ///< wall time of the stepping loop [s]
   std::string output_dir;              ///< where the outputs are
   std::string checkpoint;              ///< last checkpoint written ("" if none)
-  int signal = 0;                      ///< signal that interrupted the run (0: not interrupted)
+  bool interrupted = false;            ///< stopped before end_time by a signal or stop_after
+  int signal = 0;                      ///< signal that interrupted the run (0: none)
 };
 
 /// A checkpoint and the input of the run it continues.

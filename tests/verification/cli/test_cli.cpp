@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "mpmcd/checkpoint/checkpoint.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -123,6 +125,18 @@ TEST(Cli, InvertedPointStopsWithExit3AndLastGoodState) {
   EXPECT_NE(r.output.find("step 1"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("grain 0"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_last_good.vtu")) << r.output;
+  // A loadable checkpoint of the last good step (step 0), named in the diagnostic.
+  const fs::path ckpt = dir / "out" / "mpmcd_checkpoint_000000000.h5";
+  EXPECT_NE(r.output.find("checkpoint of the last good step: " + ckpt.string()), std::string::npos)
+      << r.output;
+  const auto state = mpmcd::checkpoint::read(ckpt.string());
+  EXPECT_EQ(state.step, 0);
+  EXPECT_EQ(state.reason, "failure");
+  EXPECT_EQ(state.points(), 208u);
+  // Resuming it meets the same failure: exit 3 again, not a crash.
+  const Result again = run("run --restart " + ckpt.string());
+  EXPECT_EQ(again.code, 3) << again.output;
+  EXPECT_NE(again.output.find("J = "), std::string::npos) << again.output;
 }
 
 TEST(Cli, PointLeavingTheGridStopsWithExit3) {
