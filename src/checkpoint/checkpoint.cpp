@@ -111,7 +111,9 @@ class Writer {
     if (!file_.ok()) fail("create");
   }
   void group(const char* name) {
-    Handle g(H5Gcreate2(file_.get(), name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    Handle gcpl(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
+    H5Pset_obj_track_times(gcpl.get(), false);  // no timestamps: same state, same bytes
+    Handle g(H5Gcreate2(file_.get(), name, H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose);
     if (!g.ok()) fail(name);
   }
   template <class T>
@@ -120,8 +122,10 @@ class Writer {
     for (hsize_t d : dims) total *= d;
     if (total != data.size()) fail(name + " (size)");
     Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose);
+    Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    H5Pset_obj_track_times(dcpl.get(), false);
     Handle set(H5Dcreate2(file_.get(), name.c_str(), H5Type<T>::file(), space.get(), H5P_DEFAULT,
-                          H5P_DEFAULT, H5P_DEFAULT),
+                          dcpl.get(), H5P_DEFAULT),
                H5Dclose);
     if (!space.ok() || !set.ok()) fail(name);
     if (!data.empty() &&
