@@ -1,6 +1,7 @@
 // The `mpmcd` command line as a user runs it: exit codes (0 ok, 2 bad input, 3 numerical failure),
 // nothing written for a bad input, the outputs of a run, the last good state after a failure.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -41,7 +42,8 @@ std::string read(const fs::path& p) {
 }
 
 fs::path scratch(const std::string& name) {
-  fs::path p = fs::temp_directory_path() / ("mpmcd_cli_" + name);
+  // The pid keeps concurrent test runs (other build trees on the machine) apart.
+  fs::path p = fs::temp_directory_path() / ("mpmcd_cli_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(p);
   fs::create_directories(p);
   return p;

@@ -30,7 +30,9 @@ namespace ck = mpmcd::checkpoint;
 namespace {
 
 fs::path scratch(const std::string& name) {
-  fs::path p = fs::temp_directory_path() / ("mpmcd_restart_" + name);
+  // The pid keeps concurrent test runs (other build trees on the machine) apart.
+  fs::path p =
+      fs::temp_directory_path() / ("mpmcd_restart_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(p);
   fs::create_directories(p);
   return p;
@@ -72,7 +74,8 @@ fs::path write_case(const fs::path& dir, int steps, const std::string& checkpoin
 }
 
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }
 
 // The final states and every output file of two runs are identical, bit for bit.
@@ -212,7 +215,7 @@ TEST(Restart, SigtermThenResumeIsBitwise) {
   const fs::path out = dir / "run";
   const pid_t pid =
       spawn({"run", "-t", "1", in.string(), "-o", out.string()}, dir / "interrupted.log");
-  ASSERT_TRUE(wait_for([&] { return csv_rows(out / "pair.csv") >= 40; }));
+  ASSERT_TRUE(wait_for([&] { return csv_rows(out / "pair.csv") >= n / 4; }));
   kill(pid, SIGTERM);
   const int code = wait_exit(pid);
   const std::string log = read(dir / "interrupted.log");
