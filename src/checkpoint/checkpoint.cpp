@@ -180,7 +180,8 @@ void fsync_path(const std::string& path, int flags) {
 // Reading.
 class Reader {
  public:
-  explicit Reader(const std::string& path) : path_(path) {
+  // `max_bytes`: the file size; no dataset can hold more (contiguous, uncompressed).
+  Reader(const std::string& path, std::size_t max_bytes) : path_(path), max_bytes_(max_bytes) {
     file_ = Handle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
     if (!file_.ok()) fail("", "not a readable HDF5 file");
   }
@@ -205,7 +206,12 @@ class Reader {
         fail(name, fmt::format("dimension {} is {}, expected {}", k, got[k], dims[k]));
       total *= dims[k];
     }
-    if (total > (hsize_t{1} << 34)) fail(name, "implausibly large");
+    // Sizes come from the file: bound them by the file before allocating (fuzzing found a
+    // re-sealed file declaring 2^32 entries).
+    if (total > max_bytes_ / sizeof(T))
+      fail(name, fmt::format("declares {} entries, more than the file can hold", total));
+    if (total > 0 && H5Dget_storage_size(set.get()) < total * sizeof(T))
+      fail(name, "its stored data is shorter than its size");
     std::vector<T> out(static_cast<std::size_t>(total));
     if (total > 0 &&
         H5Dread(set.get(), H5Type<T>::mem(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
@@ -227,6 +233,7 @@ class Reader {
 
  private:
   std::string path_;
+  std::size_t max_bytes_;
   Handle file_;
 };
 
@@ -353,6 +360,7 @@ State read(const std::string& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw refuse("no such file");
   // 1. Header, size and checksum before libhdf5 sees the file.
+  std::size_t file_bytes = 0;
   {
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) throw refuse("cannot open the file");
@@ -378,6 +386,7 @@ State read(const std::string& path) {
           fmt::format("the file holds {} bytes after its header, its header says {} "
                       "(truncated or appended to)",
                       bytes, want_bytes));
+    file_bytes = kUserBlock + bytes;
     if (sum != want_sum)
       throw refuse(
           fmt::format("checksum mismatch (fnv1a64 {:016x}, header says {:016x}): the "
@@ -385,7 +394,7 @@ State read(const std::string& path) {
                       sum, static_cast<std::uint64_t>(want_sum)));
   }
   // 2. Datasets, types and sizes.
-  Reader r(path);
+  Reader r(path, file_bytes);
   State s;
   constexpr hsize_t any = Reader::kAny;
   if (r.text("/meta/format") != kMagic) r.fail("/meta/format", "not an mpmcd checkpoint");
