@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <iostream>
 
 #include "mpmcd/app/analyze.hpp"
@@ -36,7 +37,16 @@ int run_cli(int argc, char** argv) {
   RunOptions run_opt;
   std::string run_input;
   auto* run = cli.add_subcommand("run", "run a simulation from a TOML input");
-  run->add_option("input", run_input, "input file (TOML, see docs/input.md)")->required();
+  run->add_option("input", run_input,
+                  "input file (TOML, see docs/input.md); with --restart optional (the checkpoint "
+                  "holds the input), and if given it must be the same text");
+  run->add_option("--restart", run_opt.restart,
+                  "continue from a checkpoint file (<name>_checkpoint_<step>.h5); outputs go on "
+                  "in the checkpoint's folder unless -o is given");
+  run->add_option("--stop-after", run_opt.stop_after,
+                  "stop after this many steps (of this invocation) as if interrupted: write a "
+                  "checkpoint and exit 4 (chunks of a long run under a job time limit)")
+      ->check(CLI::PositiveNumber);
   run->add_flag("-q,--quiet", run_opt.quiet, "no progress or info lines");
   run->add_option("-o,--output", run_opt.output_dir, "output folder (overrides [output] folder)");
   run->add_option("-t,--threads", run_opt.threads, "OpenMP threads (overrides [simulation])")
@@ -85,8 +95,26 @@ int run_cli(int argc, char** argv) {
   try {
     if (*run) {
       setup_logging(run_opt.quiet ? Verbosity::kQuiet : Verbosity::kNormal);
-      const io::Config cfg = io::load_config(run_input);
-      run_simulation(cfg, run_opt);
+      if (run_input.empty() && run_opt.restart.empty())
+        throw InputError("mpmcd run: an input file is required (or --restart <checkpoint>)");
+      RunSummary summary;
+      if (!run_opt.restart.empty()) {
+        const Restart restart = load_restart(run_opt.restart, run_input);
+        summary = run_simulation(restart.config, run_opt, &restart.state);
+      } else {
+        summary = run_simulation(io::load_config(run_input), run_opt);
+      }
+      if (summary.interrupted) {
+        const std::string by = summary.signal == SIGINT    ? "SIGINT"
+                               : summary.signal == SIGTERM ? "SIGTERM"
+                               : summary.signal != 0 ? fmt::format("signal {}", summary.signal)
+                                                     : std::string("--stop-after");
+        std::cerr << fmt::format(
+            "mpmcd: interrupted ({}) at step {} (t = {:.9g} s); state saved in {}\n"
+            "mpmcd: resume with: mpmcd run --restart {}\n",
+            by, summary.steps, summary.time, summary.checkpoint, summary.checkpoint);
+        return static_cast<int>(ExitCode::kInterrupted);
+      }
     } else if (*check) {
       const io::Config cfg = io::load_config(check_input);
       const auto model = build_model(cfg);

@@ -732,11 +732,21 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     const std::int32_t a = c.a < 0 ? -1 - c.wall : problem_.slots[c.a].grain;
     previous_.push_back({problem_.slots[c.b].node, a, problem_.slots[c.b].grain, c.impulse});
   }
-  std::sort(previous_.begin(), previous_.end(), [](const PrevImpulse& x, const PrevImpulse& y) {
-    return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
-  });
+  std::sort(previous_.begin(), previous_.end(),
+            [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
+              return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
+            });
   step_ready_ = true;
   return stats;
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::set_warm_start(std::vector<WarmImpulse<Dim>> impulses) {
+  previous_ = std::move(impulses);
+  std::sort(previous_.begin(), previous_.end(),
+            [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
+              return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
+            });
 }
 
 template <int Dim>
@@ -775,9 +785,9 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   }
   ++stamp_;
   const auto warm = [&](std::int64_t node, std::int32_t a, std::int32_t b) -> Vec<Dim> {
-    const PrevImpulse key{node, a, b, Vec<Dim>::Zero()};
+    const WarmImpulse<Dim> key{node, a, b, Vec<Dim>::Zero()};
     auto it = std::lower_bound(previous_.begin(), previous_.end(), key,
-                               [](const PrevImpulse& x, const PrevImpulse& y) {
+                               [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
                                  return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
                                });
     if (it != previous_.end() && it->node == node && it->a == a && it->b == b) return it->impulse;

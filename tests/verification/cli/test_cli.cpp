@@ -1,12 +1,15 @@
 // The `mpmcd` command line as a user runs it: exit codes (0 ok, 2 bad input, 3 numerical failure),
 // nothing written for a bad input, the outputs of a run, the last good state after a failure.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "mpmcd/checkpoint/checkpoint.hpp"
 
 namespace fs = std::filesystem;
 
@@ -39,7 +42,8 @@ std::string read(const fs::path& p) {
 }
 
 fs::path scratch(const std::string& name) {
-  fs::path p = fs::temp_directory_path() / ("mpmcd_cli_" + name);
+  // The pid keeps concurrent test runs (other build trees on the machine) apart.
+  fs::path p = fs::temp_directory_path() / ("mpmcd_cli_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(p);
   fs::create_directories(p);
   return p;
@@ -123,6 +127,18 @@ TEST(Cli, InvertedPointStopsWithExit3AndLastGoodState) {
   EXPECT_NE(r.output.find("step 1"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("grain 0"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_last_good.vtu")) << r.output;
+  // A loadable checkpoint of the last good step (step 0), named in the diagnostic.
+  const fs::path ckpt = dir / "out" / "mpmcd_checkpoint_000000000.h5";
+  EXPECT_NE(r.output.find("checkpoint of the last good step: " + ckpt.string()), std::string::npos)
+      << r.output;
+  const auto state = mpmcd::checkpoint::read(ckpt.string());
+  EXPECT_EQ(state.step, 0);
+  EXPECT_EQ(state.reason, "failure");
+  EXPECT_EQ(state.points(), 227u);  // the disk on rings (polar seeding, the default for disks)
+  // Resuming it meets the same failure: exit 3 again, not a crash.
+  const Result again = run("run --restart " + ckpt.string());
+  EXPECT_EQ(again.code, 3) << again.output;
+  EXPECT_NE(again.output.find("J = "), std::string::npos) << again.output;
 }
 
 TEST(Cli, PointLeavingTheGridStopsWithExit3) {
