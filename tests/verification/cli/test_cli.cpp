@@ -67,6 +67,22 @@ TEST(Cli, CheckAcceptsTheExample) {
   EXPECT_NE(r.output.find("valid (1 grains"), std::string::npos) << r.output;
 }
 
+// Every simulation input under examples/ stays valid (packing inputs, pack.toml, are `mpmcd pack`
+// inputs and are checked by the packing tests).
+TEST(Cli, CheckAcceptsEveryExampleInput) {
+  int checked = 0;
+  for (const auto& e : fs::recursive_directory_iterator(fs::path(MPMCD_SOURCE_DIR) / "examples")) {
+    if (!e.is_regular_file() || e.path().extension() != ".toml" ||
+        e.path().filename() == "pack.toml")
+      continue;
+    if (e.path().string().find("/output") != std::string::npos) continue;  // run outputs
+    const Result r = run("check " + e.path().string());
+    EXPECT_EQ(r.code, 0) << e.path() << ": " << r.output;
+    ++checked;
+  }
+  EXPECT_GE(checked, 8);
+}
+
 TEST(Cli, BadInputExitsWith2AndWritesNothing) {
   const fs::path dir = scratch("bad");
   const fs::path in = write_input(dir,
