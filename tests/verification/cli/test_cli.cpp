@@ -11,24 +11,14 @@
 
 #include "mpmcd/checkpoint/checkpoint.hpp"
 
+#include "../../support/cli_runner.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;
-};
-
-Result run(const std::string& args) {
-  const std::string cmd = std::string(MPMCD_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (pipe && fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using mpmcd::test_support::Result;
+using mpmcd::test_support::run;
 
 std::string example() {
   return std::string(MPMCD_SOURCE_DIR) + "/examples/squeezed_disk/squeezed_disk.toml";
