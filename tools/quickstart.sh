@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # Quick start: installs what is missing (Debian packages), builds mpmcd (Release) and runs the main
-# example, then draws its last snapshot. Usage: tools/quickstart.sh   (from anywhere)
+# example, a scaled-down compaction of 40 soft disks (examples/quick_compaction), then fits the
+# compaction law (mpmcd analyze) and draws snapshots like the paper's Figure 3.
+# Usage: tools/quickstart.sh   (from anywhere)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install_deps.sh
 cmake --preset release
 cmake --build --preset release --target mpmcd
-out=output/squeezed_disk
-./build/release/mpmcd run examples/squeezed_disk/squeezed_disk.toml -o "$out"
-last=$(ls "$out"/squeezed_disk_*.vtu | tail -n 1)
-/usr/bin/python3 tools/plot_points.py "$last" "$out/last_snapshot.png" --field pressure
-echo "quickstart: outputs in $out (open squeezed_disk.pvd in ParaView; picture: $out/last_snapshot.png)"
+out=output/quick_compaction
+./build/release/mpmcd run examples/quick_compaction/quick_compaction.toml -o "$out"
+./build/release/mpmcd analyze "$out" -o "$out/analysis"
+/usr/bin/python3 tools/plot_snapshots.py "$out" --phi 0.78 0.9 0.97 --field pressure -o "$out/snapshots"
+echo "quickstart: outputs in $out (time series quick_compaction.csv, quick_compaction.pvd for" \
+  "ParaView, analysis/figure4.png and figure5.png, snapshots/*.png)"

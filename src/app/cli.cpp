@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <iostream>
 
 #include "mpmcd/app/analyze.hpp"
@@ -12,6 +13,7 @@
 #include "mpmcd/io/load_config.hpp"
 #include "mpmcd/materials/law.hpp"
 #include "mpmcd/packing/pack_command.hpp"
+#include "mpmcd/parallel/comm.hpp"
 #include "mpmcd/version.hpp"
 
 namespace mpmcd::app {
@@ -36,7 +38,16 @@ int run_cli(int argc, char** argv) {
   RunOptions run_opt;
   std::string run_input;
   auto* run = cli.add_subcommand("run", "run a simulation from a TOML input");
-  run->add_option("input", run_input, "input file (TOML, see docs/input.md)")->required();
+  run->add_option("input", run_input,
+                  "input file (TOML, see docs/input.md); with --restart optional (the checkpoint "
+                  "holds the input), and if given it must be the same text");
+  run->add_option("--restart", run_opt.restart,
+                  "continue from a checkpoint file (<name>_checkpoint_<step>.h5); outputs go on "
+                  "in the checkpoint's folder unless -o is given");
+  run->add_option("--stop-after", run_opt.stop_after,
+                  "stop after this many steps (of this invocation) as if interrupted: write a "
+                  "checkpoint and exit 4 (chunks of a long run under a job time limit)")
+      ->check(CLI::PositiveNumber);
   run->add_flag("-q,--quiet", run_opt.quiet, "no progress or info lines");
   run->add_option("-o,--output", run_opt.output_dir, "output folder (overrides [output] folder)");
   run->add_option("-t,--threads", run_opt.threads, "OpenMP threads (overrides [simulation])")
@@ -89,11 +100,33 @@ int run_cli(int argc, char** argv) {
     return rc == 0 ? 0 : static_cast<int>(ExitCode::kInput);
   }
 
+  // `mpmcd run` may be one rank of several (docs/parallel.md); the other commands are serial.
+  const parallel::Comm* comm = *run ? &parallel::Comm::world() : nullptr;
+  const bool rank0 = !comm || comm->rank() == 0;
   try {
     if (*run) {
       setup_logging(run_opt.quiet ? Verbosity::kQuiet : Verbosity::kNormal);
-      const io::Config cfg = io::load_config(run_input);
-      run_simulation(cfg, run_opt);
+      if (run_input.empty() && run_opt.restart.empty())
+        throw InputError("mpmcd run: an input file is required (or --restart <checkpoint>)");
+      RunSummary summary;
+      if (!run_opt.restart.empty()) {
+        const Restart restart = load_restart(run_opt.restart, run_input);
+        summary = run_simulation(restart.config, run_opt, &restart.state);
+      } else {
+        summary = run_simulation(io::load_config(run_input), run_opt);
+      }
+      if (summary.interrupted) {
+        const std::string by = summary.signal == SIGINT    ? "SIGINT"
+                               : summary.signal == SIGTERM ? "SIGTERM"
+                               : summary.signal != 0 ? fmt::format("signal {}", summary.signal)
+                                                     : std::string("--stop-after");
+        if (rank0)
+          std::cerr << fmt::format(
+              "mpmcd: interrupted ({}) at step {} (t = {:.9g} s); state saved in {}\n"
+              "mpmcd: resume with: mpmcd run --restart {}\n",
+              by, summary.steps, summary.time, summary.checkpoint, summary.checkpoint);
+        return static_cast<int>(ExitCode::kInterrupted);
+      }
     } else if (*check) {
       const io::Config cfg = io::load_config(check_input);
       const auto model = build_model(cfg);
@@ -112,13 +145,21 @@ int run_cli(int argc, char** argv) {
         print_laws();
     }
   } catch (const InputError& e) {
-    std::cerr << "mpmcd: input error: " << e.what() << "\n";
+    // Input and numerical errors are met by every rank in the same step (the input is read and
+    // the step verdict reduced on all of them): rank 0 reports, every rank returns the code.
+    if (rank0) std::cerr << "mpmcd: input error: " << e.what() << "\n";
     return static_cast<int>(ExitCode::kInput);
   } catch (const NumericalError& e) {
-    std::cerr << "mpmcd: the simulation cannot go on: " << e.what() << "\n";
+    if (rank0) std::cerr << "mpmcd: the simulation cannot go on: " << e.what() << "\n";
     return static_cast<int>(ExitCode::kNumerical);
   } catch (const std::exception& e) {
-    std::cerr << "mpmcd: error: " << e.what() << "\n";
+    // Possibly this rank's alone (a file it cannot write, memory): the others would wait in the
+    // next collective, so the whole job ends here.
+    const bool many = comm && comm->size() > 1;
+    std::cerr << (many ? fmt::format("mpmcd (rank {}): error: ", comm->rank())
+                       : std::string("mpmcd: error: "))
+              << e.what() << "\n";
+    if (many) comm->abort(static_cast<int>(ExitCode::kRuntime));
     return static_cast<int>(ExitCode::kRuntime);
   }
   return 0;

@@ -17,6 +17,14 @@ double grain_area(const mpm::Model<2>& model) {
   return vs;
 }
 
+// Vs0 = Σ_p V0_p: the initial grain area, also after a restart (equal bit for bit to Σ_p V_p at
+// t = 0, where V_p = V0_p).
+double reference_grain_area(const mpm::Model<2>& model) {
+  double vs = 0;
+  for (double v : model.points.volume0) vs += v;
+  return vs;
+}
+
 Vec<2> force_on(const mpm::StepStats& step, std::size_t k) {
   if (k >= step.wall_force.size()) return Vec<2>::Zero();  // before the first step
   return Vec<2>(step.wall_force[k][0], step.wall_force[k][1]);
@@ -31,7 +39,7 @@ CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Mode
                       Vec<2>(w.velocity.at(0), w.velocity.at(1))});
   box_ = analysis::find_box(walls_);
   if (box_) box0_ = analysis::box_at(walls_, *box_, 0.0);
-  vs0_ = grain_area(model);
+  vs0_ = reference_grain_area(model);
   grains_ = static_cast<std::int64_t>(model.grains.size());
   contact_ = config.contact.enabled && (grains_ > 1 || !config.walls.empty());
   // M_p = λ + 2μ of the grains' material: defined when every material used by a grain has the

@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -13,6 +15,7 @@
 #include "mpmcd/app/compaction_observer.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
+#include "mpmcd/io/load_config.hpp"
 #include "mpmcd/io/vtu.hpp"
 #include "mpmcd/packing/input.hpp"
 #include "mpmcd/packing/packing.hpp"
@@ -100,7 +103,10 @@ void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t
 
 }  // namespace
 
-mpm::Model<2> build_model(const io::Config& cfg) {
+namespace {
+
+// The grid and the materials of the input, no grains yet.
+mpm::Model<2> model_frame(const io::Config& cfg) {
   mpm::Model<2> model;
   const double h = cfg.grid.cell_size;
   IVec<2> cells;
@@ -114,6 +120,14 @@ mpm::Model<2> build_model(const io::Config& cfg) {
       throw InputError(cfg.source_path, m.line, "materials." + e.key(), e.what());
     }
   }
+  return model;
+}
+
+}  // namespace
+
+mpm::Model<2> build_model(const io::Config& cfg) {
+  mpm::Model<2> model = model_frame(cfg);
+  const double h = cfg.grid.cell_size;
   for (std::size_t i = 0; i < cfg.grains.size(); ++i) {
     const auto& g = cfg.grains[i];
     int material = -1;
@@ -271,10 +285,29 @@ void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {
   vtu.write(path);
 }
 
+// Keeps the header and the first `rows` complete rows of the CSV at `path` (drops the rows
+// written after a checkpoint and a torn last line); returns the rows kept.
+std::int64_t trim_csv(const std::string& path, std::int64_t rows) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::size_t end = 0;
+  std::int64_t kept = -1;  // the header is line 0
+  while (kept < rows) {
+    const std::size_t nl = text.find('\n', end);
+    if (nl == std::string::npos) break;
+    end = nl + 1;
+    ++kept;
+  }
+  io::write_file_atomic(path, text.substr(0, end));
+  return std::max<std::int64_t>(kept, 0);
+}
+
 class Outputs {
  public:
-  // `extra_header`: further CSV columns (CompactionObserver), starting with a comma.
-  Outputs(const io::Config& cfg, const std::string& dir, const std::string& extra_header)
+  // `extra_header`: further CSV columns (CompactionObserver), starting with a comma; `restart`:
+  // the checkpoint a restarted run continues (nullptr: a new run).
+  Outputs(const io::Config& cfg, const std::string& dir, const std::string& extra_header,
+          const checkpoint::State* restart)
       : cfg_(cfg), dir_(dir) {
     fs::create_directories(dir_);
     // Input copy, stamped with the version that ran it.
@@ -283,37 +316,66 @@ class Outputs {
         fmt::format("# run by mpmcd {} ({}) from {}\n", kVersion, kGitHash, cfg.source_path) +
             cfg.source_text);
     csv_path_ = (fs::path(dir_) / (cfg.simulation.name + ".csv")).string();
-    csv_.open(csv_path_, std::ios::trunc);
+    std::string header =
+        "step,time,dt,newton_iterations,linear_solves,kinetic_energy,elastic_energy,"
+        "total_energy,momentum_x,momentum_y,mass,volume,contacts,active_contacts,gs_sweeps";
+    for (const auto& w : cfg.walls) header += ",wall_" + w.name + "_fx,wall_" + w.name + "_fy";
+    header += extra_header + "\n";
+    if (restart && fs::exists(csv_path_)) {
+      csv_rows_ = trim_csv(csv_path_, restart->csv_rows);
+      if (csv_rows_ < restart->csv_rows)
+        log().warn("{} holds {} of the {} rows written before the checkpoint", csv_path_, csv_rows_,
+                   restart->csv_rows);
+      csv_rows_ = restart->csv_rows;
+      csv_.open(csv_path_, std::ios::binary | std::ios::app);
+    } else {
+      if (restart) log().warn("{} is missing: it restarts at step {}", csv_path_, restart->step);
+      csv_rows_ = restart ? restart->csv_rows : 0;
+      csv_.open(csv_path_, std::ios::binary | std::ios::trunc);
+      write_row(header);
+    }
     if (!csv_) throw std::runtime_error("cannot open " + csv_path_);
-    csv_ << "step,time,dt,newton_iterations,linear_solves,kinetic_energy,elastic_energy,"
-            "total_energy,momentum_x,momentum_y,mass,volume,contacts,active_contacts,gs_sweeps";
-    for (const auto& w : cfg.walls) csv_ << ",wall_" << w.name << "_fx,wall_" << w.name << "_fy";
-    csv_ << extra_header << "\n";
     if (cfg_.output.vtu)
       pvd_ = std::make_unique<io::PvdSeries>(
           (fs::path(dir_) / (cfg.simulation.name + ".pvd")).string());
+    if (restart && pvd_) {  // the series so far: file names follow from the snapshot index
+      for (const double t : restart->vtu_times) {
+        pvd_->restore(t, fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_));
+        vtu_times_.push_back(t);
+        ++vtu_count_;
+      }
+    }
+  }
+  // Restores the contact series of a restart (only runs with contact write it).
+  void restore_contacts(const mpm::ImplicitSolver<2>& solver) {
+    if (!pvd_ || !solver.settings().contact.enabled) return;
+    contacts_pvd_ = std::make_unique<io::PvdSeries>(
+        (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
+    for (std::size_t k = 0; k < vtu_times_.size(); ++k)
+      contacts_pvd_->restore(vtu_times_[k],
+                             fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, k));
   }
   void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& st,
                const mpm::Diagnostics<2>& d, const std::string& extra) {
-    csv_ << fmt::format(
+    std::string row = fmt::format(
         "{},{:.12e},{:.6e},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", step, t,
         dt, st.iterations, st.linear_solves, d.kinetic, d.elastic, d.kinetic + d.elastic,
         d.momentum[0], d.momentum[1], d.mass, d.volume);
-    csv_ << fmt::format(",{},{},{}", st.contacts, st.active_contacts, st.gs_sweeps);
+    row += fmt::format(",{},{},{}", st.contacts, st.active_contacts, st.gs_sweeps);
     for (std::size_t k = 0; k < cfg_.walls.size(); ++k) {
       const bool have = k < st.wall_force.size();
-      csv_ << fmt::format(",{:.12e},{:.12e}", have ? st.wall_force[k][0] : 0.0,
-                          have ? st.wall_force[k][1] : 0.0);
+      row += fmt::format(",{:.12e},{:.12e}", have ? st.wall_force[k][0] : 0.0,
+                         have ? st.wall_force[k][1] : 0.0);
     }
-    csv_ << extra << "\n";
-    csv_.flush();
+    row += extra + "\n";
+    write_row(row);
+    ++csv_rows_;
   }
   void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
            const contact::Problem<2>& problem, double t) {
     if (!pvd_) return;
     const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
     write_points_vtu(model, (fs::path(dir_) / name).string());
-    pvd_->add(t, name);
     if (solver.settings().contact.enabled) {
       const std::string cname =
           fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
@@ -326,8 +388,15 @@ class Outputs {
             (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
       contacts_pvd_->add(t, cname);
     }
+    pvd_->add(t, name);  // last: a series lists only snapshots whose files are complete
+    vtu_times_.push_back(t);
     ++vtu_count_;
   }
+  /// CSV rows written so far (header excluded).
+  std::int64_t csv_rows() const { return csv_rows_; }
+  /// Times of the VTU snapshots written so far [s].
+  const std::vector<double>& vtu_times() const { return vtu_times_; }
+  const std::string& dir() const { return dir_; }
   // Contacts as points at their nodes (normal, impulses, the two bodies; walls as -1 - index),
   // and the per-pair aggregated contact force sum P / dt as a CSV.
   void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& pb,
@@ -356,7 +425,7 @@ class Outputs {
       gap[i] = c.gap;
       body_a[i] = c.a >= 0 ? pb.slots[c.a].grain : -1 - c.wall;
       body_b[i] = sb.grain;
-      // try_emplace with zero: a default-constructed Eigen vector is uninitialised.
+      // try_emplace with an explicit zero: Eigen vectors are not zero-initialised.
       pairs.try_emplace({body_a[i], body_b[i]}, Vec<2>::Zero()).first->second += c.impulse * inv_dt;
     }
     vtu.write(vtu_path);
@@ -374,55 +443,225 @@ class Outputs {
  private:
   const io::Config& cfg_;
   std::string dir_, csv_path_;
+  // One whole row per write, flushed: a crash leaves complete rows (a torn last line, possible
+  // only if the disk fills up, is dropped on restart).
+  void write_row(const std::string& row) {
+    csv_.write(row.data(), static_cast<std::streamsize>(row.size()));
+    csv_.flush();
+    if (!csv_) throw std::runtime_error("cannot write " + csv_path_);
+  }
+
   std::ofstream csv_;
   std::unique_ptr<io::PvdSeries> pvd_, contacts_pvd_;
   int vtu_count_ = 0;
+  std::int64_t csv_rows_ = 0;
+  std::vector<double> vtu_times_;
 };
 
 }  // namespace
 
-RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
+namespace {
+
+// SIGINT / SIGTERM: the handler only records the signal; the loop finishes its step, writes a
+// checkpoint and returns. SA_RESETHAND: a second signal gets the default action (stops at once).
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void on_stop_signal(int sig) {
+  g_signal = sig;
+}
+
+class SignalGuard {
+ public:
+  SignalGuard() {
+    g_signal = 0;
+    struct sigaction sa = {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND;
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~SignalGuard() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  SignalGuard(const SignalGuard&) = delete;
+  SignalGuard& operator=(const SignalGuard&) = delete;
+
+ private:
+  struct sigaction old_int_ = {}, old_term_ = {};
+};
+
+const char* signal_name(int sig) {
+  return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal";
+}
+
+// The model of a restart: grid and materials from the input, points and grains from the
+// checkpoint (no packing is regenerated). Throws InputError if they do not fit together.
+mpm::Model<2> restore_model(const io::Config& cfg, const checkpoint::State& s,
+                            const std::string& path) {
+  const auto refuse = [&](const std::string& what) {
+    return InputError(path, 0, "", "checkpoint does not fit its input: " + what);
+  };
+  if (s.dim != 2) throw refuse(fmt::format("dimension {}", s.dim));
+  mpm::Model<2> model = model_frame(cfg);
+  const std::size_t n = s.points();
+  auto& p = model.points;
+  p.x.resize(n);
+  p.v.resize(n);
+  p.F.resize(n);
+  p.sigma.resize(n);
+  p.domain.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    p.x[i] = Vec<2>(s.x[2 * i], s.x[2 * i + 1]);
+    p.v[i] = Vec<2>(s.v[2 * i], s.v[2 * i + 1]);
+    p.F[i] << s.F[4 * i], s.F[4 * i + 1], s.F[4 * i + 2], s.F[4 * i + 3];
+    p.sigma[i] << s.sigma[4 * i], s.sigma[4 * i + 1], s.sigma[4 * i + 2], s.sigma[4 * i + 3];
+    p.domain[i] << s.domain[4 * i], s.domain[4 * i + 1], s.domain[4 * i + 2], s.domain[4 * i + 3];
+  }
+  p.sigma_zz = s.sigma_zz;
+  p.mass = s.mass;
+  p.volume0 = s.volume0;
+  p.volume = s.volume;
+  p.grain = s.grain;
+  p.history = s.history;
+  for (std::size_t g = 0; g < s.grain_begin.size(); ++g) {
+    points::Grain gr;
+    gr.begin = s.grain_begin[g];
+    gr.end = s.grain_end[g];
+    gr.material = s.grain_material[g];
+    gr.half_width = s.grain_half_width[g];
+    gr.history_offset = s.grain_history_offset[g];
+    if (gr.material >= static_cast<int>(model.laws.size()))
+      throw refuse(fmt::format("grain {} has material {}, the input has {} materials", g,
+                               gr.material, model.laws.size()));
+    const std::int64_t hs = model.laws[gr.material]->history_size();
+    if (gr.history_offset + hs * gr.size() > static_cast<std::int64_t>(p.history.size()))
+      throw refuse(fmt::format("grain {}: history shorter than its law needs", g));
+    model.grains.push_back(gr);
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (!model.grid.inside(p.x[i], 0.0))
+      throw refuse(fmt::format("point {} lies outside the grid", i));
+  const auto ng = static_cast<std::int32_t>(model.grains.size());
+  const auto nwall = static_cast<std::int32_t>(cfg.walls.size());
+  for (std::size_t k = 0; k < s.warm_node.size(); ++k)
+    if (s.warm_node[k] < 0 || s.warm_node[k] >= model.grid.node_count() || s.warm_b[k] < 0 ||
+        s.warm_b[k] >= ng || s.warm_a[k] >= ng || s.warm_a[k] < -nwall)
+      throw refuse(
+          fmt::format("contact warm-start entry {} names a node or body that does not "
+                      "exist",
+                      k));
+  if (s.wall_point.size() != 2 * cfg.walls.size())
+    throw refuse(fmt::format("{} walls in the checkpoint, {} in the input", s.wall_point.size() / 2,
+                             cfg.walls.size()));
+  return model;
+}
+
+}  // namespace
+
+Restart load_restart(const std::string& path, const std::string& input) {
+  Restart r;
+  r.path = path;
+  r.state = checkpoint::read(path);
+  if (input.empty()) {
+    r.config = io::parse_config(r.state.input_text, r.state.input_path);
+  } else {
+    r.config = io::load_config(input);
+    if (checkpoint::fnv1a(r.config.source_text) != r.state.input_hash)
+      throw InputError(input, 0, "",
+                       fmt::format("this input is not the one checkpoint '{}' was written from "
+                                   "({}); a restart continues the same run: give that input or "
+                                   "none (the checkpoint holds it)",
+                                   path, r.state.input_path));
+  }
+  return r;
+}
+
+RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
+                          const checkpoint::State* restart) {
   RunSummary summary;
   const int threads = opt.threads > 0 ? opt.threads : cfg.simulation.threads;
   if (threads > 0) omp_set_num_threads(threads);
-  mpm::Model<2> model = build_model(cfg);  // may throw InputError: before any output
+  // May throw InputError: before any output.
+  mpm::Model<2> model = restart ? restore_model(cfg, *restart, opt.restart) : build_model(cfg);
   auto settings = build_settings(cfg);
-  check_walls_enclose(cfg, model, settings);  // may throw InputError: before any output
+  if (!restart) check_walls_enclose(cfg, model, settings);
   bool any_moving = false;
   for (const auto& b : cfg.boundaries) any_moving = any_moving || b.moving;
 
   summary.output_dir = opt.output_dir.empty() ? cfg.output.folder : opt.output_dir;
-  if (fs::path(summary.output_dir).is_relative() && opt.output_dir.empty())
+  if (restart && opt.output_dir.empty()) {  // continue where the checkpoint lies
+    const fs::path parent = fs::path(opt.restart).parent_path();
+    summary.output_dir = parent.empty() ? "." : parent.string();
+  } else if (fs::path(summary.output_dir).is_relative() && opt.output_dir.empty()) {
     summary.output_dir =
         (fs::path(cfg.source_path).parent_path() / summary.output_dir).lexically_normal().string();
+  }
   const CompactionObserver observer(cfg, model);
   // Processes (docs/parallel.md): every rank holds the model and computes its grains; rank 0
-  // gathers the state at output times and writes every file.
+  // gathers the state at output and checkpoint times and writes every file.
   const auto& comm = parallel::Comm::world();
   const bool root = comm.rank() == 0;
   if (!root) log().set_level(spdlog::level::off);  // rank 0 reports
+  SignalGuard signals;
   mpm::ImplicitSolver<2> solver(model.grid, settings, model.points, model.grains, model.law_ptrs());
   solver.set_boundary_conditions(build_boundaries(cfg, model.grid, 0.0));
   const parallel::Scheme scheme =
       parallel::scheme_from_string(opt.scheme.empty() ? "partition" : opt.scheme);
-  if (comm.size() > 1)
-    solver.set_distribution(
-        &comm, parallel::deal_grains(model.points, model.grains, scheme, comm.size()), scheme);
+  // A restart on the same ranks and scheme keeps the checkpoint's distribution and re-balancing
+  // counts (bitwise continuation); otherwise the grains are dealt again from the restored state.
+  const bool keep =
+      restart && restart->ranks == comm.size() && restart->scheme == parallel::to_string(scheme);
+  if (comm.size() > 1) {
+    std::vector<int> owner =
+        keep ? std::vector<int>(restart->grain_owner.begin(), restart->grain_owner.end())
+             : parallel::deal_grains(model.points, model.grains, scheme, comm.size());
+    solver.set_distribution(&comm, owner, scheme);
+  }
+  if (keep) {
+    std::vector<double> work(restart->grain_work);
+    for (std::size_t g = 0; g < work.size(); ++g)
+      if (restart->grain_owner[g] != comm.rank()) work[g] = 0;
+    solver.set_grain_work(std::move(work));
+  }
   std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
-  if (root) out_ptr = std::make_unique<Outputs>(cfg, summary.output_dir, observer.csv_header());
+  if (root)
+    out_ptr = std::make_unique<Outputs>(cfg, summary.output_dir, observer.csv_header(), restart);
   const bool stop_active = cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0;
   const auto gather_state = [&](int to) {
     ScopedStage ts(&solver.timers(), "output");
     parallel::gather_points(comm, model.points, model.grains, solver.owner(), to);
   };
 
-  log().info("mpmcd {} ({}): {} grains, {} material points, grid {}x{} cells of {} m, {} threads",
-             kVersion, kGitHash, model.grains.size(), model.points.size(), model.grid.cells()[0],
-             model.grid.cells()[1], model.grid.cell_size(), omp_get_max_threads());
+  log().info(
+      "mpmcd {} ({}): {} grains, {} material points, grid {}x{} cells of {} m, {} rank(s) x {} "
+      "threads",
+      kVersion, kGitHash, model.grains.size(), model.points.size(), model.grid.cells()[0],
+      model.grid.cells()[1], model.grid.cell_size(), comm.size(), omp_get_max_threads());
   const double dt_nominal = cfg.time.dt, t_end = cfg.time.end_time;
   double t = 0, dt = dt_nominal;
-  int good_since_cut = 0;
+  std::int64_t good_since_cut = 0;
   double next_vtu = 0, next_csv = 0;
+  if (restart) {
+    t = restart->time;
+    dt = restart->dt;
+    good_since_cut = restart->good_since_cut;
+    next_vtu = restart->next_vtu;
+    next_csv = restart->next_csv;
+    summary.steps = restart->step;
+    summary.failed_steps = restart->failed_steps;
+    summary.newton_iterations = restart->newton_iterations;
+    // Every rank gets every impulse; a rank looks up only the contacts it solves.
+    std::vector<mpm::WarmImpulse<2>> warm(restart->warm_node.size());
+    for (std::size_t k = 0; k < warm.size(); ++k)
+      warm[k] = {restart->warm_node[k], restart->warm_a[k], restart->warm_b[k],
+                 Vec<2>(restart->warm_impulse[2 * k], restart->warm_impulse[2 * k + 1])};
+    solver.set_warm_start(std::move(warm));
+    if (root) out_ptr->restore_contacts(solver);
+    log().info("restarted from {} (written by mpmcd {} on {} rank(s)): step {}, t = {:.9g} s",
+               opt.restart, restart->mpmcd_version, restart->ranks, summary.steps, t);
+  }
   mpm::StepStats last;
   auto record = [&](bool force) {
     const double eps = 1e-9 * dt_nominal;
@@ -442,26 +681,146 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
       next_vtu = t + cfg.output.vtu_interval;
     }
   };
-  record(true);
+  // Writes the checkpoint of the committed state (collective: rank 0 gathers every grain and
+  // every rank's warm-start impulses and writes one file); returns its path on rank 0.
+  std::int64_t last_checkpoint_step = restart ? restart->step : -1;
+  auto write_checkpoint = [&](const std::string& reason) {
+    ScopedStage ts(&solver.timers(), "checkpoint");
+    if (comm.size() > 1) gather_state(0);
+    // Warm-start impulses of every rank (each contact is solved by one rank).
+    parallel::Buffer mine;
+    for (const auto& w : solver.warm_start()) {
+      mine.put(w.node);
+      mine.put(w.a);
+      mine.put(w.b);
+      mine.put(w.impulse[0]);
+      mine.put(w.impulse[1]);
+    }
+    const auto all = comm.allgather(mine.bytes());
+    std::vector<double> work = solver.grain_work();
+    work.resize(model.grains.size(), 0.0);
+    comm.sum(work);
+    last_checkpoint_step = summary.steps;
+    if (!root) return std::string();
+    std::vector<mpm::WarmImpulse<2>> warm;
+    for (const auto& bytes : all) {
+      parallel::Buffer b;
+      b.bytes() = bytes;
+      while (!b.done()) {
+        mpm::WarmImpulse<2> w;
+        w.node = b.get<std::int64_t>();
+        w.a = b.get<std::int32_t>();
+        w.b = b.get<std::int32_t>();
+        w.impulse[0] = b.get<double>();
+        w.impulse[1] = b.get<double>();
+        warm.push_back(w);
+      }
+    }
+    std::sort(warm.begin(), warm.end(), [](const auto& x, const auto& y) {
+      return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
+    });
+    Outputs& out = *out_ptr;
+    checkpoint::State s;
+    s.dim = 2;
+    s.input_text = cfg.source_text;
+    s.input_path = cfg.source_path;
+    s.reason = reason;
+    s.step = summary.steps;
+    s.time = t;
+    s.dt = dt;
+    s.good_since_cut = good_since_cut;
+    s.failed_steps = summary.failed_steps;
+    s.newton_iterations = summary.newton_iterations;
+    s.next_vtu = next_vtu;
+    s.next_csv = next_csv;
+    s.csv_rows = out.csv_rows();
+    s.vtu_times = out.vtu_times();
+    const auto& p = model.points;
+    const std::size_t n = p.size();
+    s.x.resize(2 * n);
+    s.v.resize(2 * n);
+    s.F.resize(4 * n);
+    s.sigma.resize(4 * n);
+    s.domain.resize(4 * n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < 2; ++a) {
+        s.x[2 * i + a] = p.x[i][a];
+        s.v[2 * i + a] = p.v[i][a];
+        for (int b = 0; b < 2; ++b) {
+          s.F[4 * i + 2 * a + b] = p.F[i](a, b);
+          s.sigma[4 * i + 2 * a + b] = p.sigma[i](a, b);
+          s.domain[4 * i + 2 * a + b] = p.domain[i](a, b);
+        }
+      }
+    s.sigma_zz = p.sigma_zz;
+    s.mass = p.mass;
+    s.volume0 = p.volume0;
+    s.volume = p.volume;
+    s.grain = p.grain;
+    s.history = p.history;
+    for (const auto& g : model.grains) {
+      s.grain_begin.push_back(g.begin);
+      s.grain_end.push_back(g.end);
+      s.grain_material.push_back(g.material);
+      s.grain_half_width.push_back(g.half_width);
+      s.grain_history_offset.push_back(g.history_offset);
+    }
+    for (const auto& w : warm) {
+      s.warm_node.push_back(w.node);
+      s.warm_a.push_back(w.a);
+      s.warm_b.push_back(w.b);
+      s.warm_impulse.push_back(w.impulse[0]);
+      s.warm_impulse.push_back(w.impulse[1]);
+    }
+    for (const auto& w : settings.contact.walls) {
+      const Vec<2> x = w.point + t * w.velocity;
+      s.wall_point.push_back(x[0]);
+      s.wall_point.push_back(x[1]);
+    }
+    s.ranks = comm.size();
+    s.scheme = parallel::to_string(scheme);
+    s.grain_owner.assign(model.grains.size(), 0);
+    if (comm.size() > 1)
+      for (std::size_t g = 0; g < model.grains.size(); ++g) s.grain_owner[g] = solver.owner()[g];
+    s.grain_work = work;
+    const std::string path =
+        (fs::path(out.dir()) / checkpoint::file_name(cfg.simulation.name, s.step)).string();
+    checkpoint::write(s, path);
+    checkpoint::prune(out.dir(), cfg.simulation.name, cfg.checkpoint.keep);
+    summary.checkpoint = path;
+    log().info("checkpoint ({}) at step {}, t = {:.9g} s: {}", reason, s.step, t, path);
+    return path;
+  };
+  if (!restart) record(true);
   const auto wall0 = std::chrono::steady_clock::now();
-  auto last_progress = wall0;
+  auto last_progress = wall0, last_checkpoint_wall = wall0;
+  const std::int64_t steps0 = summary.steps;
   while (t < t_end - 1e-9 * dt_nominal) {
     const double dt_try = std::min(dt, t_end - t);
     solver.set_time(t);
     if (any_moving) solver.set_boundary_conditions(build_boundaries(cfg, model.grid, t + dt_try));
     mpm::StepStats st = solver.solve_step(dt_try);
-    if (!st.converged) {
+    if (!st.converged) {  // the same verdict on every rank (the solver reduces it)
       ++summary.failed_steps;
       const double dt_new = dt_try * cfg.time.cut_factor;
       if (!st.retryable || dt_new < cfg.time.dt_min) {
         if (comm.size() > 1) gather_state(0);
         const std::string saved = root ? out_ptr->last_good(model) : std::string();
-        log().error("last good state (t = {:.9g} s) written to {}", t, saved);
-        throw NumericalError(st.retryable ? fmt::format("{}; dt cut down to dt_min = {:.3g} s "
-                                                        "did not help",
-                                                        st.failure, cfg.time.dt_min)
-                                          : st.failure,
-                             summary.steps + 1, t, st.grain, st.point);
+        log().error("last good state (step {}, t = {:.9g} s) written to {}", summary.steps, t,
+                    saved);
+        std::string ckpt;
+        try {
+          ckpt = write_checkpoint("failure");
+        } catch (const std::exception& e) {
+          log().error("no checkpoint of the last good state: {}", e.what());
+        }
+        std::string reason = st.retryable ? fmt::format(
+                                                "{}; dt cut down to dt_min = {:.3g} s "
+                                                "did not help",
+                                                st.failure, cfg.time.dt_min)
+                                          : st.failure;
+        if (!ckpt.empty()) reason += fmt::format("; checkpoint of the last good step: {}", ckpt);
+        throw NumericalError(reason, summary.steps + 1, t, st.grain, st.point);
       }
       log().warn("step {} at t = {:.9g} s failed ({}), retrying with dt = {:.4g} s",
                  summary.steps + 1, t, st.failure, dt_new);
@@ -492,46 +851,80 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt) {
       good_since_cut = 0;
       log().info("dt restored to {:.4g} s at t = {:.9g} s", dt, t);
     }
-    if (stop_active && comm.size() > 1) gather_state(-1);  // Phi needs every grain's area
-    const auto stop = observer.stop_reason(model, st, t);  // [stop] criteria
-    record(stop || t >= t_end - 1e-9 * dt_nominal);
-    if (stop) {
-      log().info("step {}, t = {:.9g} s: {}", summary.steps, t, *stop);
-      summary.stop_reason = *stop;
+    if (stop_active && comm.size() > 1) gather_state(-1);       // Phi needs every grain's area
+    const auto criterion = observer.stop_reason(model, st, t);  // [stop] criteria
+    const bool at_end = criterion.has_value() || t >= t_end - 1e-9 * dt_nominal;
+    record(at_end);
+    if (criterion) {
+      log().info("step {}, t = {:.9g} s: {}", summary.steps, t, *criterion);
+      summary.stop_reason = *criterion;
       break;
     }
     const auto now = std::chrono::steady_clock::now();
+    const bool stop = opt.stop_after > 0 && summary.steps - steps0 >= opt.stop_after;
+    const bool due_steps =
+        cfg.checkpoint.every_steps > 0 && summary.steps % cfg.checkpoint.every_steps == 0;
+    // Signals and wall-clock deadlines reach the ranks at different times: they act when any
+    // rank has seen them, on every rank in the same step.
+    std::vector<double> flags{
+        static_cast<double>(g_signal),
+        cfg.checkpoint.every_minutes > 0 &&
+                std::chrono::duration<double>(now - last_checkpoint_wall).count() >=
+                    60.0 * cfg.checkpoint.every_minutes
+            ? 1.0
+            : 0.0};
+    if (comm.size() > 1) comm.max(flags);
+    const int signal = static_cast<int>(flags[0]);
+    const bool due_wall = flags[1] > 0;
+    if ((signal != 0 || stop) && !at_end) {
+      summary.signal = signal;
+      summary.interrupted = true;
+      write_checkpoint(signal != 0 ? "signal" : "stop_after");
+      break;
+    }
+    if ((due_steps || due_wall) && !(at_end && cfg.checkpoint.at_end)) {
+      write_checkpoint("periodic");
+      last_checkpoint_wall = now;
+    }
     if (std::chrono::duration<double>(now - last_progress).count() >=
         cfg.output.progress_interval) {
       last_progress = now;
       const double wall = std::chrono::duration<double>(now - wall0).count();
-      const double rate = summary.steps / wall;
+      const double rate = static_cast<double>(summary.steps - steps0) / wall;
       const double eta = (t_end - t) / dt_nominal / std::max(rate, 1e-30);
       log().info("step {:>7}  t = {:.6e} s ({:5.1f}%)  newton {}  {:.1f} steps/s  ETA {:.0f} s",
                  summary.steps, t, 100 * t / t_end, st.iterations, rate, eta);
     }
   }
+  if (!summary.interrupted && cfg.checkpoint.at_end && last_checkpoint_step != summary.steps)
+    write_checkpoint("end");
   summary.time = t;
   summary.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   std::string timers;
   for (const auto& [name, secs] : solver.timers().totals())
     timers += fmt::format(" {} {:.2f} s", name, secs);
-  log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,
-             summary.failed_steps, t, summary.wall_seconds, timers);
   // Per-stage timers over ranks with the serial shares (docs/parallel.md): <name>_timers.csv.
   std::vector<double> bytes{static_cast<double>(comm.bytes_sent())};
   comm.sum(bytes);
   const auto report = parallel::stage_report(comm, solver.timers().totals());
   const std::string csv = parallel::stage_report_csv(
-      report, summary.wall_seconds, comm.size(), omp_get_max_threads(), summary.steps,
-      bytes[0] / comm.size() / std::max<std::int64_t>(summary.steps, 1));
+      report, summary.wall_seconds, comm.size(), omp_get_max_threads(), summary.steps - steps0,
+      bytes[0] / comm.size() / std::max<std::int64_t>(summary.steps - steps0, 1));
   if (root) {
     io::write_file_atomic(
         (fs::path(summary.output_dir) / (cfg.simulation.name + "_timers.csv")).string(), csv);
     log().info("{} rank(s), scheme {}: timers in {}_timers.csv", comm.size(),
                parallel::to_string(scheme), cfg.simulation.name);
   }
+  if (summary.interrupted) {
+    log().warn("stopped ({}) at step {} (t = {:.9g} s)",
+               summary.signal != 0 ? signal_name(summary.signal) : "--stop-after", summary.steps,
+               t);
+    return summary;
+  }
+  log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,
+             summary.failed_steps, t, summary.wall_seconds, timers);
   log().info("outputs in {}", summary.output_dir);
   return summary;
 }

@@ -96,7 +96,8 @@ Schema build_schema() {
         KeySpec::subtable("contact", "contact", "Contact Dynamics").defaults("its defaults"),
         KeySpec::table_array("walls", "walls[]", "rigid walls").defaults("none"),
         KeySpec::subtable("stop", "stop", "compaction stop criteria").defaults("none"),
-        KeySpec::subtable("output", "output", "output files").defaults("its defaults")},
+        KeySpec::subtable("output", "output", "output files").defaults("its defaults"),
+        KeySpec::subtable("checkpoint", "checkpoint", "restart files").defaults("its defaults")},
        ""});
 
   s.tables.push_back(
@@ -393,6 +394,28 @@ Schema build_schema() {
             .greater_than(0.0)
             .defaults(num(d.output.progress_interval))},
        ""});
+
+  s.tables.push_back(
+      {"checkpoint",
+       "[checkpoint]",
+       "Restart files `<name>_checkpoint_<step>.h5` (HDF5) in the output folder; "
+       "`mpmcd run --restart <file>` continues a run bitwise (docs/robustness.md). A checkpoint is "
+       "also written when the run is interrupted (SIGINT, SIGTERM) and when it stops on a "
+       "numerical failure (the last good step), whatever these keys say.",
+       {KeySpec::integer("every_steps", "", "committed steps between checkpoints, 0 = never")
+            .at_least(0)
+            .defaults(num(d.checkpoint.every_steps)),
+        KeySpec::number("every_minutes", "min", "wall-clock time between checkpoints, 0 = never")
+            .at_least(0.0)
+            .at_most(525600.0)
+            .defaults(num(d.checkpoint.every_minutes)),
+        KeySpec::integer("keep", "", "checkpoints kept (the oldest are deleted)")
+            .at_least(1)
+            .at_most(1000)
+            .defaults(num(d.checkpoint.keep)),
+        KeySpec::boolean("at_end", "write a checkpoint when the run reaches `end_time`")
+            .defaults(boolean_text(d.checkpoint.at_end))},
+       ""});
   return s;
 }
 
@@ -424,6 +447,7 @@ class ConfigReader {
     read_walls(r, c);
     read_stop(r, c);
     read_output(r, c);
+    read_checkpoint(r, c);
     return c;
   }
 
@@ -801,6 +825,15 @@ class ConfigReader {
     r.read("csv_interval", o.csv_interval);
     r.read("vtu", o.vtu);
     r.read("progress_interval", o.progress_interval);
+  }
+
+  void read_checkpoint(const TableReader& root, Config& c) {
+    TableReader r = sub(root, "checkpoint", "checkpoint");
+    CheckpointSection& k = c.checkpoint;
+    r.read("every_steps", k.every_steps);
+    r.read("every_minutes", k.every_minutes);
+    r.read("keep", k.keep);
+    r.read("at_end", k.at_end);
   }
 
   const toml::table& root_;

@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
+#include <string_view>
 
 #include "mpmcd/core/errors.hpp"
 #include "params_check.hpp"
@@ -266,9 +269,17 @@ PackingInput load_packing_input(const std::string& path) {
     throw InputError(
         path, 0, "",
         fmt::format("an input file of at most {} bytes, got {}", kMaxInputBytes, bytes));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "", "a readable packing input file (TOML)");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return parse_packing_input(buffer.str(), path);
+}
+
+PackingInput parse_packing_input(std::string_view text, const std::string& path) {
   toml::table root;
   try {
-    root = toml::parse_file(path);
+    root = toml::parse(text, std::string_view(path));
   } catch (const toml::parse_error& e) {
     throw InputError(path, static_cast<std::int64_t>(e.source().begin.line), "",
                      fmt::format("valid TOML: {}", e.description()));

@@ -90,8 +90,13 @@ Packing read_packing_csv(const std::string& path) {
   if (!in) throw fail(0, "", "cannot open the packing file");
   std::ostringstream buffer;
   buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  return parse_packing_csv(buffer.str(), path);
+}
 
+Packing parse_packing_csv(std::string_view text, const std::string& path) {
+  const auto fail = [&](std::int64_t line, const std::string& key, const std::string& what) {
+    return InputError(path, line, key, what);
+  };
   Packing packing;
   bool has_box = false;
   std::int64_t box_line = 0;

@@ -41,6 +41,13 @@ void Comm::finalize() {
   g_finalized = true;
 }
 
+void Comm::abort(int code) const {
+#ifdef MPMCD_WITH_MPI
+  if (size_ > 1) MPI_Abort(MPI_COMM_WORLD, code);
+#endif
+  (void)code;
+}
+
 bool Comm::has_mpi() {
 #ifdef MPMCD_WITH_MPI
   return true;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "mpmcd/checkpoint/checkpoint.hpp"
 #include "mpmcd/io/config.hpp"
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
@@ -13,10 +14,13 @@ namespace mpmcd::app {
 
 /// Command-line options of `mpmcd run`.
 struct RunOptions {
-  bool quiet = false;      ///< no progress lines or info messages
-  std::string output_dir;  ///< overrides [output] folder if not empty
-  int threads = 0;         ///< overrides [simulation] threads if > 0
-  std::string scheme;      ///< parallel scheme "partition" (default) or "master" (docs/parallel.md)
+  bool quiet = false;           ///< no progress lines or info messages
+  std::string output_dir;       ///< overrides [output] folder if not empty
+  int threads = 0;              ///< overrides [simulation] threads if > 0
+  std::string restart;          ///< checkpoint to continue from ("" = start at t = 0)
+  std::int64_t stop_after = 0;  ///< if > 0: stop after this many steps of this invocation, as if
+                                ///< interrupted (checkpoint written; for job time limits, tests)
+  std::string scheme;           ///< parallel scheme "partition" (default) or "master" (docs/parallel.md)
   double rebalance = 1.1;  ///< partition: re-deal above this work imbalance max/mean (0: never) [-]
 };
 
@@ -29,7 +33,22 @@ struct RunSummary {
   double wall_seconds = 0;             ///< wall time of the stepping loop [s]
   std::string output_dir;              ///< where the outputs are
   std::string stop_reason;             ///< the [stop] criterion reached, "" if end_time
+  std::string checkpoint;              ///< last checkpoint written ("" if none)
+  bool interrupted = false;            ///< stopped before end_time by a signal or stop_after
+  int signal = 0;                      ///< signal that interrupted the run (0: none)
 };
+
+/// A checkpoint and the input of the run it continues.
+struct Restart {
+  io::Config config;        ///< the validated input
+  checkpoint::State state;  ///< the state to continue from
+  std::string path;         ///< the checkpoint file
+};
+
+/// Reads checkpoint `path` (refused with InputError if damaged) and the input it continues:
+/// `input` if not empty (its text must be the one the checkpoint was written from), else the input
+/// text stored in the checkpoint. Throws InputError (exit 2).
+Restart load_restart(const std::string& path, const std::string& input);
 
 /// Builds the 2D model (grid, materials, seeded grains, initial velocities) from the input;
 /// throws InputError for inputs that pass the schema but cannot be built (e.g. a grain too small
@@ -48,8 +67,11 @@ mpm::Settings<2> build_settings(const io::Config& config);
 void check_walls_enclose(const io::Config& config, const mpm::Model<2>& model,
                          const mpm::Settings<2>& settings);
 
-/// Runs the whole simulation; throws InputError (exit 2) or NumericalError (exit 3, after writing
-/// the last good state).
-RunSummary run_simulation(const io::Config& config, const RunOptions& options);
+/// Runs the whole simulation, from t = 0 or from `restart` (options.restart names its file);
+/// throws InputError (exit 2) or NumericalError (exit 3, after writing the last good state and
+/// its checkpoint). SIGINT/SIGTERM finish the current step, write a checkpoint and return with
+/// RunSummary::signal set (exit 4 in the command line).
+RunSummary run_simulation(const io::Config& config, const RunOptions& options,
+                          const checkpoint::State* restart = nullptr);
 
 }  // namespace mpmcd::app

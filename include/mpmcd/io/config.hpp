@@ -148,6 +148,15 @@ struct OutputSection {
   double progress_interval = 2.0;  ///< wall time between progress lines [s]
 };
 
+/// [checkpoint]: when to write restart files (docs/robustness.md). A checkpoint is also written
+/// on SIGINT/SIGTERM and on a numerical failure, whatever these settings.
+struct CheckpointSection {
+  std::int64_t every_steps = 0;  ///< committed steps between checkpoints, 0 = never [-]
+  double every_minutes = 30.0;   ///< wall-clock time between checkpoints, 0 = never [min]
+  int keep = 2;                  ///< checkpoints kept in the output folder (oldest deleted) [-]
+  bool at_end = true;            ///< write one when the run reaches end_time [-]
+};
+
 /// The whole validated input.
 struct Config {
   std::string source_path;  ///< path of the TOML file it came from
@@ -164,6 +173,7 @@ struct Config {
   std::vector<WallSection> walls;
   StopSection stop;
   OutputSection output;
+  CheckpointSection checkpoint;
 };
 
 }  // namespace mpmcd::io

@@ -52,6 +52,10 @@ class PvdSeries {
   explicit PvdSeries(std::string path) : path_(std::move(path)) {}
   /// Appends (time [s], file name relative to the .pvd) and rewrites the .pvd.
   void add(double time, const std::string& relative_file);
+  /// Appends (time [s], file name) without rewriting the .pvd (rebuilding a series on restart).
+  void restore(double time, const std::string& relative_file) {
+    entries_.emplace_back(time, relative_file);
+  }
 
  private:
   std::string path_;

@@ -116,6 +116,15 @@ struct StepStats {
       wall_force;  ///< force of the grains on each wall [N] (2D: N/m)
 };
 
+/// A contact impulse of the last converged step, used to warm start the next one.
+template <int Dim>
+struct WarmImpulse {
+  std::int64_t node = 0;                ///< global grid node [-]
+  std::int32_t a = 0;                   ///< body a: grain >= 0 or wall -1 - index [-]
+  std::int32_t b = 0;                   ///< grain b [-]
+  Vec<Dim> impulse = Vec<Dim>::Zero();  ///< impulse on b over the step [N s] (2D: N s/m)
+};
+
 /// Implicit MPM stepper: grains with their own nodal fields, coupled by Contact Dynamics.
 /// Holds non-owning references to the points, grains and laws, which must outlive it.
 template <int Dim>
@@ -142,12 +151,20 @@ class ImplicitSolver {
   /// Work of each grain computed here since the last call, points x Newton iterations summed over
   /// steps (0 for grains of other ranks); deterministic, for re-balancing. Resets the counts.
   std::vector<double> take_grain_work();
+  /// The work counts since the last take_grain_work, per grain [-] (checkpoints).
+  const std::vector<double>& grain_work() const { return grain_work_; }
+  /// Replaces the work counts (a restart; 0 for grains of other ranks) [-].
+  void set_grain_work(std::vector<double> work) { grain_work_ = std::move(work); }
   /// True when the step runs on more than one rank.
   bool distributed() const { return comm_ != nullptr && comm_->size() > 1; }
   /// Sets the time t^n [s] of the next step (wall positions).
   void set_time(double t) { time_ = t; }
   /// The contact problem of the last step (impulses solved), for output and replay.
   const contact::Problem<Dim>& contact_problem() const { return problem_; }
+  /// Warm-start impulses kept from the last converged step, sorted by (node, a, b).
+  const std::vector<WarmImpulse<Dim>>& warm_start() const { return previous_; }
+  /// Replaces the warm-start impulses (a restart); sorts them by (node, a, b).
+  void set_warm_start(std::vector<WarmImpulse<Dim>> impulses);
   /// Attempts the step t -> t + dt [s] from the committed point state; changes no point data.
   StepStats solve_step(double dt);
   /// Commits the last converged step: G2P positions and velocities, F, stress, volume, history.
@@ -208,12 +225,7 @@ class ImplicitSolver {
   std::vector<std::int32_t> slot_next_;                 // per slot: next slot at the same node
   std::uint32_t stamp_ = 0;
   bool gs_converged_ = true;
-  struct PrevImpulse {
-    std::int64_t node;
-    std::int32_t a, b;
-    Vec<Dim> impulse;
-  };
-  std::vector<PrevImpulse> previous_;  // sorted by (node, a, b)
+  std::vector<WarmImpulse<Dim>> previous_;  // sorted by (node, a, b)
   // Distribution (docs/parallel.md): owner rank per grain, this rank's grains, ghost grains (their
   // contact nodes received from their owners), the neighbour ranks and, per neighbour, the slots
   // whose velocity / impulse travel each Newton iteration.

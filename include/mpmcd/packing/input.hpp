@@ -2,6 +2,7 @@
 /// The packing input file (TOML, docs/packing.md §5): a [packing] table (also embeddable in the
 /// simulation input) and an [output] table.
 #include <string>
+#include <string_view>
 
 #include <toml++/toml.h>
 
@@ -28,5 +29,8 @@ PackingParams packing_params_from_toml(const toml::table& table, const std::stri
 /// Loads and validates a packing input file ([packing] required, [output] optional); throws
 /// InputError on unreadable files, TOML syntax errors and every schema violation.
 PackingInput load_packing_input(const std::string& path);
+
+/// Validates the text of a packing input; `path` names it in messages (throws InputError).
+PackingInput parse_packing_input(std::string_view text, const std::string& path);
 
 }  // namespace mpmcd::packing

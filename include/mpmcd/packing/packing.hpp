@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace mpmcd::packing {
@@ -104,6 +105,8 @@ void write_packing_csv(const Packing& packing, const std::string& path);
 /// Reads a CSV packing file; throws InputError(file, line, column, expectation) on bad content.
 /// Without a `# box =` comment the box is the bounding box of the disks.
 Packing read_packing_csv(const std::string& path);
+/// Parses the text of a CSV packing file; `path` names it in messages (throws InputError).
+Packing parse_packing_csv(std::string_view text, const std::string& path);
 /// Writes a VTU point cloud: points = centers [m], arrays radius [m], diameter [m], id [-].
 void write_packing_vtu(const Packing& packing, const std::string& path);
 /// One-line summary: grains, achieved phi, largest overlap / mean diameter.

@@ -55,6 +55,9 @@ class Comm {
   static bool has_mpi();
   /// Waits for every rank.
   void barrier() const;
+  /// Ends every process of the job with exit status `code` (an error seen by this rank alone,
+  /// which would leave the others waiting); returns only on one rank or without MPI.
+  void abort(int code) const;
   /// Element-wise sum over ranks, added in rank order (bitwise reproducible for a rank count).
   void sum(std::vector<double>& values) const;
   /// Element-wise integer sum over ranks.

@@ -1,6 +1,7 @@
 // The `mpmcd` command line as a user runs it: exit codes (0 ok, 2 bad input, 3 numerical failure),
 // nothing written for a bad input, the outputs of a run, the last good state after a failure.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -8,24 +9,16 @@
 #include <fstream>
 #include <sstream>
 
+#include "mpmcd/checkpoint/checkpoint.hpp"
+
+#include "../../support/cli_runner.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;
-};
-
-Result run(const std::string& args) {
-  const std::string cmd = std::string(MPMCD_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (pipe && fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using mpmcd::test_support::Result;
+using mpmcd::test_support::run;
 
 std::string example() {
   return std::string(MPMCD_SOURCE_DIR) + "/examples/squeezed_disk/squeezed_disk.toml";
@@ -39,7 +32,8 @@ std::string read(const fs::path& p) {
 }
 
 fs::path scratch(const std::string& name) {
-  fs::path p = fs::temp_directory_path() / ("mpmcd_cli_" + name);
+  // The pid keeps concurrent test runs (other build trees on the machine) apart.
+  fs::path p = fs::temp_directory_path() / ("mpmcd_cli_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(p);
   fs::create_directories(p);
   return p;
@@ -61,6 +55,22 @@ TEST(Cli, CheckAcceptsTheExample) {
   const Result r = run("check " + example());
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("valid (1 grains"), std::string::npos) << r.output;
+}
+
+// Every simulation input under examples/ stays valid (packing inputs, pack.toml, are `mpmcd pack`
+// inputs and are checked by the packing tests).
+TEST(Cli, CheckAcceptsEveryExampleInput) {
+  int checked = 0;
+  for (const auto& e : fs::recursive_directory_iterator(fs::path(MPMCD_SOURCE_DIR) / "examples")) {
+    if (!e.is_regular_file() || e.path().extension() != ".toml" ||
+        e.path().filename() == "pack.toml")
+      continue;
+    if (e.path().string().find("/output") != std::string::npos) continue;  // run outputs
+    const Result r = run("check " + e.path().string());
+    EXPECT_EQ(r.code, 0) << e.path() << ": " << r.output;
+    ++checked;
+  }
+  EXPECT_GE(checked, 8);
 }
 
 TEST(Cli, BadInputExitsWith2AndWritesNothing) {
@@ -123,6 +133,18 @@ TEST(Cli, InvertedPointStopsWithExit3AndLastGoodState) {
   EXPECT_NE(r.output.find("step 1"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("grain 0"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_last_good.vtu")) << r.output;
+  // A loadable checkpoint of the last good step (step 0), named in the diagnostic.
+  const fs::path ckpt = dir / "out" / "mpmcd_checkpoint_000000000.h5";
+  EXPECT_NE(r.output.find("checkpoint of the last good step: " + ckpt.string()), std::string::npos)
+      << r.output;
+  const auto state = mpmcd::checkpoint::read(ckpt.string());
+  EXPECT_EQ(state.step, 0);
+  EXPECT_EQ(state.reason, "failure");
+  EXPECT_EQ(state.points(), 227u);  // the disk on rings (polar seeding, the default for disks)
+  // Resuming it meets the same failure: exit 3 again, not a crash.
+  const Result again = run("run --restart " + ckpt.string());
+  EXPECT_EQ(again.code, 3) << again.output;
+  EXPECT_NE(again.output.find("J = "), std::string::npos) << again.output;
 }
 
 TEST(Cli, PointLeavingTheGridStopsWithExit3) {

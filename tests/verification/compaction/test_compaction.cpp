@@ -19,25 +19,15 @@
 #include "mpmcd/app/simulation.hpp"
 #include "mpmcd/io/load_config.hpp"
 
+#include "../../support/cli_runner.hpp"
+
 namespace fs = std::filesystem;
 using mpmcd::analysis::TimeSeries;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;
-};
-
-Result run(const std::string& args) {
-  const std::string cmd = std::string(MPMCD_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (pipe && fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using mpmcd::test_support::Result;
+using mpmcd::test_support::run;
 
 fs::path scratch(const std::string& name) {
   fs::path p = fs::temp_directory_path() / ("mpmcd_compaction_" + name);

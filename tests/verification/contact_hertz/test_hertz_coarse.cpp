@@ -1,9 +1,9 @@
-// Coarse 2D Hertz (method.md §7): the polar-seeded disk of long_hertz/test_hertz.cpp at 10 and 20 cells per
-// diameter (linear shapes), squeezed to Delta/D = 0.05 between a fixed bottom wall and a top wall
-// moving down at 0.3 m/s (0.004 c_p). Checks: the loading is quasi-static (the two window-averaged
-// wall forces agree, the kinetic energy is small), no point domain goes deeper than 0.1 h into a
-// wall, and the RMS error against Hertz over 0.005 <= Delta/D <= 0.05 at least halves from 10 to
-// 20 cells per diameter. Default suite (about 13 s).
+// Coarse 2D Hertz (method.md §7): the polar-seeded disk of long_hertz/test_hertz.cpp at 10 and 20
+// cells per diameter (linear shapes), squeezed to Delta/D = 0.05 between a fixed bottom wall and a
+// top wall moving down at 0.3 m/s (0.004 c_p). Checks: the loading is quasi-static (the two
+// window-averaged wall forces agree, the kinetic energy is small), no point domain goes deeper than
+// 0.1 h into a wall, and the RMS error against Hertz over 0.005 <= Delta/D <= 0.05 at least halves
+// from 10 to 20 cells per diameter. Default suite (about 13 s).
 #include <gtest/gtest.h>
 
 #include "../../support/contact_builders.hpp"

@@ -1,0 +1,298 @@
+// Runs that survive: a run stopped half way (--stop-after, SIGTERM to the real binary, SIGKILL)
+// and resumed from its checkpoint ends bitwise identical to an uninterrupted run: point arrays,
+// contact warm start, CSV rows, every VTU. Damaged checkpoints and foreign inputs are refused with
+// exit 2; a numerical failure leaves a loadable checkpoint of the last good step.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mpmcd/app/simulation.hpp"
+#include "mpmcd/checkpoint/checkpoint.hpp"
+#include "mpmcd/core/errors.hpp"
+#include "mpmcd/core/log.hpp"
+#include "mpmcd/io/load_config.hpp"
+
+namespace fs = std::filesystem;
+namespace ck = mpmcd::checkpoint;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  // The pid keeps concurrent test runs (other build trees on the machine) apart.
+  fs::path p =
+      fs::temp_directory_path() / ("mpmcd_restart_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Two gel disks thrown at each other in a box of three walls under gravity: they collide at
+// about step 12, bounce off each other and the side walls (contacts all along, so warm-start
+// impulses matter). About 3 ms per step.
+fs::path write_case(const fs::path& dir, int steps, const std::string& checkpoint) {
+  const fs::path p = dir / "pair.toml";
+  std::ofstream(p) << "[simulation]\nname = \"pair\"\n"
+                      "[grid]\norigin = [0.0, 0.0]\nextent = [0.02, 0.012]\ncell_size = 0.001\n"
+                      "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\n"
+                      "lambda = 3e6\nmu = 1.5e6\n"
+                      "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                      "center = [0.006, 0.005]\nradius = 0.0035\n"
+                      "[grains.initial]\nvelocity = [1.0, 0.0]\n"
+                      "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                      "center = [0.0135, 0.0055]\nradius = 0.0035\n"
+                      "[grains.initial]\nvelocity = [-1.0, 0.0]\n"
+                      "[[walls]]\nname = \"floor\"\npoint = [0.0, 0.0012]\nnormal = [0.0, 1.0]\n"
+                      "[[walls]]\nname = \"left\"\npoint = [0.0015, 0.0]\nnormal = [1.0, 0.0]\n"
+                      "[[walls]]\nname = \"right\"\npoint = [0.0185, 0.0]\nnormal = [-1.0, 0.0]\n"
+                      "[loads]\ngravity = [0.0, -9.81]\n"
+                      "[time]\ndt = 2e-5\nend_time = "
+                   << steps * 2e-5
+                   << "\n[contact]\nfriction = 0.3\n"
+                      "[output]\nfolder = \"out\"\nvtu_interval = 1e-4\n"
+                      "[checkpoint]\n"
+                   << checkpoint;
+  return p;
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+// The final states and every output file of two runs are identical, bit for bit.
+void expect_identical_runs(const fs::path& a, const fs::path& b, std::int64_t steps) {
+  const ck::State sa = ck::read((a / ck::file_name("pair", steps)).string());
+  const ck::State sb = ck::read((b / ck::file_name("pair", steps)).string());
+  EXPECT_EQ(sa.step, sb.step);
+  EXPECT_EQ(std::memcmp(&sa.time, &sb.time, sizeof(double)), 0);
+  EXPECT_TRUE(same_bits(sa.x, sb.x)) << "positions differ";
+  EXPECT_TRUE(same_bits(sa.v, sb.v)) << "velocities differ";
+  EXPECT_TRUE(same_bits(sa.F, sb.F)) << "deformation gradients differ";
+  EXPECT_TRUE(same_bits(sa.sigma, sb.sigma)) << "stresses differ";
+  EXPECT_TRUE(same_bits(sa.sigma_zz, sb.sigma_zz));
+  EXPECT_TRUE(same_bits(sa.volume, sb.volume));
+  EXPECT_TRUE(same_bits(sa.history, sb.history));
+  EXPECT_EQ(sa.warm_node, sb.warm_node);
+  EXPECT_TRUE(same_bits(sa.warm_impulse, sb.warm_impulse)) << "warm-start impulses differ";
+  EXPECT_FALSE(sa.warm_node.empty()) << "the case should end with contacts";
+  EXPECT_EQ(ck::payload_checksum(sa), ck::payload_checksum(sb));
+  // No timestamps in the file: the same state gives the same bytes.
+  EXPECT_TRUE(read(a / ck::file_name("pair", steps)) == read(b / ck::file_name("pair", steps)))
+      << "final checkpoint files differ";
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(a)) {
+    const std::string ext = e.path().extension().string();
+    if (ext != ".csv" && ext != ".vtu" && ext != ".pvd") continue;
+    if (e.path().filename().string().ends_with("_timers.csv")) continue;  // wall-clock times
+    ++files;
+    const fs::path other = b / e.path().filename();
+    ASSERT_TRUE(fs::exists(other)) << other;
+    EXPECT_TRUE(read(e.path()) == read(other)) << e.path().filename() << " differs";
+  }
+  for (const auto& e : fs::directory_iterator(b))
+    EXPECT_TRUE(fs::exists(a / e.path().filename()) || e.path().extension() == ".h5" ||
+                e.path().extension() == ".log")
+        << "extra file " << e.path();
+  EXPECT_GT(files, 20);
+}
+
+// Runs the binary in the background with stdout+stderr to `log`; returns its pid.
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    FILE* f = std::freopen(log.c_str(), "w", stdout);
+    if (f == nullptr || dup2(fileno(stdout), 2) < 0) _exit(120);
+    std::vector<char*> argv;
+    static std::string bin = MPMCD_BINARY;
+    argv.push_back(bin.data());
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(bin.c_str(), argv.data());
+    _exit(121);
+  }
+  return pid;
+}
+
+int wait_exit(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+int run_binary(const std::vector<std::string>& args, const fs::path& log) {
+  return wait_exit(spawn(args, log));
+}
+
+std::int64_t csv_rows(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  std::int64_t n = -1;
+  while (std::getline(in, line)) ++n;
+  return n;
+}
+
+// Waits (up to 60 s) until `done()` holds; false on timeout.
+template <class F>
+bool wait_for(F done) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!done()) {
+    if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(60)) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+// An uninterrupted reference run of the binary in <dir>/ref.
+fs::path reference(const fs::path& dir, int steps, const std::string& checkpoint) {
+  const fs::path in = write_case(dir, steps, checkpoint);
+  const fs::path out = dir / "ref";
+  EXPECT_EQ(run_binary({"run", "-q", "-t", "1", in.string(), "-o", out.string()}, dir / "ref.log"),
+            0)
+      << read(dir / "ref.log");
+  return in;
+}
+
+}  // namespace
+
+// In process, deterministic split: N steps against N/2 (--stop-after) + restart to N.
+TEST(Restart, StopHalfWayAndResumeIsBitwise) {
+  mpmcd::setup_logging(mpmcd::Verbosity::kQuiet);
+  const fs::path dir = scratch("half");
+  const int n = 60;
+  const fs::path in = write_case(dir, n, "keep = 5\n");
+  const auto cfg = mpmcd::io::load_config(in.string());
+  mpmcd::app::RunOptions opt;
+  opt.threads = 1;
+  opt.output_dir = (dir / "full").string();
+  const auto full = mpmcd::app::run_simulation(cfg, opt);
+  EXPECT_FALSE(full.interrupted);
+  EXPECT_EQ(full.steps, n);
+
+  opt.output_dir = (dir / "split").string();
+  opt.stop_after = n / 2;
+  const auto first = mpmcd::app::run_simulation(cfg, opt);
+  EXPECT_TRUE(first.interrupted);
+  EXPECT_EQ(first.steps, n / 2);
+  ASSERT_EQ(first.checkpoint, (dir / "split" / ck::file_name("pair", n / 2)).string());
+  EXPECT_EQ(ck::read(first.checkpoint).reason, "stop_after");
+
+  // Resume with no input (the checkpoint holds it) into the checkpoint's folder.
+  const auto restart = mpmcd::app::load_restart(first.checkpoint, "");
+  mpmcd::app::RunOptions ropt;
+  ropt.threads = 1;
+  ropt.restart = first.checkpoint;
+  const auto second = mpmcd::app::run_simulation(restart.config, ropt, &restart.state);
+  EXPECT_FALSE(second.interrupted);
+  EXPECT_EQ(second.steps, n);
+  EXPECT_EQ(second.output_dir, (dir / "split").string());
+  expect_identical_runs(dir / "full", dir / "split", n);
+}
+
+// The real binary: SIGTERM after some progress -> exit 4 and the resume line; resuming it gives
+// the uninterrupted result bitwise.
+TEST(Restart, SigtermThenResumeIsBitwise) {
+  const fs::path dir = scratch("sigterm");
+  const int n = 400;
+  const fs::path in = reference(dir, n, "");
+  const fs::path out = dir / "run";
+  const pid_t pid =
+      spawn({"run", "-t", "1", in.string(), "-o", out.string()}, dir / "interrupted.log");
+  ASSERT_TRUE(wait_for([&] { return csv_rows(out / "pair.csv") >= n / 4; }));
+  kill(pid, SIGTERM);
+  const int code = wait_exit(pid);
+  const std::string log = read(dir / "interrupted.log");
+  ASSERT_EQ(code, 4) << log;
+  EXPECT_NE(log.find("interrupted (SIGTERM) at step "), std::string::npos) << log;
+  const auto ckpts = ck::list(out.string(), "pair");
+  ASSERT_EQ(ckpts.size(), 1u) << log;
+  EXPECT_NE(log.find("resume with: mpmcd run --restart " + ckpts.back()), std::string::npos) << log;
+  const ck::State s = ck::read(ckpts.back());
+  EXPECT_EQ(s.reason, "signal");
+  EXPECT_GT(s.step, 0);
+  EXPECT_LT(s.step, n);
+  EXPECT_EQ(csv_rows(out / "pair.csv"), s.step + 1);  // every row up to the interrupted step
+  // Resume, naming the input too (it must be the same text).
+  const int rc = run_binary({"run", "-q", "-t", "1", in.string(), "--restart", ckpts.back()},
+                            dir / "resume.log");
+  ASSERT_EQ(rc, 0) << read(dir / "resume.log");
+  expect_identical_runs(dir / "ref", out, n);
+}
+
+// SIGKILL at any moment leaves the last complete checkpoint readable; resuming from it (rows and
+// snapshots written after it are dropped or rewritten) still reproduces the reference bitwise.
+TEST(Restart, SigkillLeavesALoadableCheckpoint) {
+  const fs::path dir = scratch("sigkill");
+  const int n = 400;
+  const std::string every = "every_steps = 3\nkeep = 3\n";
+  const fs::path in = reference(dir, n, every);
+  const fs::path out = dir / "run";
+  const pid_t pid =
+      spawn({"run", "-q", "-t", "1", in.string(), "-o", out.string()}, dir / "killed.log");
+  ASSERT_TRUE(wait_for([&] { return csv_rows(out / "pair.csv") >= 50; }));
+  kill(pid, SIGKILL);
+  EXPECT_EQ(wait_exit(pid), 128 + SIGKILL);
+  const auto ckpts = ck::list(out.string(), "pair");
+  ASSERT_FALSE(ckpts.empty());
+  EXPECT_LE(ckpts.size(), 3u);
+  const ck::State s = ck::read(ckpts.back());  // throws if damaged
+  EXPECT_EQ(s.step % 3, 0);
+  const int rc =
+      run_binary({"run", "-q", "-t", "1", "--restart", ckpts.back()}, dir / "resume.log");
+  ASSERT_EQ(rc, 0) << read(dir / "resume.log");
+  expect_identical_runs(dir / "ref", out, n);
+}
+
+// Damaged checkpoints are refused by the command line with exit 2 and a clear message; an input
+// other than the checkpoint's is refused too.
+TEST(Restart, DamagedCheckpointOrForeignInputExits2) {
+  const fs::path dir = scratch("damaged");
+  const fs::path in = write_case(dir, 10, "");
+  ASSERT_EQ(run_binary({"run", "-q", in.string()}, dir / "run.log"), 0) << read(dir / "run.log");
+  const fs::path good = dir / "out" / ck::file_name("pair", 10);
+  const std::string bytes = read(good);
+  ASSERT_GT(bytes.size(), 1000u);
+  std::ofstream(dir / "truncated.h5", std::ios::binary) << bytes.substr(0, bytes.size() - 100);
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] = static_cast<char>(flipped[bytes.size() / 2] ^ 1);
+  std::ofstream(dir / "flipped.h5", std::ios::binary) << flipped;
+  std::ofstream(dir / "empty.h5", std::ios::binary) << "";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"truncated.h5", "truncated"},
+      {"flipped.h5", "checksum mismatch"},
+      {"empty.h5", "shorter than its 512-byte header"},
+      {"absent.h5", "no such file"}};
+  for (const auto& [file, fragment] : cases) {
+    const int rc = run_binary({"run", "--restart", (dir / file).string()}, dir / "bad.log");
+    const std::string log = read(dir / "bad.log");
+    EXPECT_EQ(rc, 2) << file << ": " << log;
+    EXPECT_NE(log.find("checkpoint refused: "), std::string::npos) << log;
+    EXPECT_NE(log.find(fragment), std::string::npos) << log;
+  }
+  // Another input: refused, the checkpoint is not loaded.
+  const fs::path other = dir / "other.toml";
+  std::ofstream(other) << read(in) << "# edited\n";
+  EXPECT_EQ(run_binary({"run", other.string(), "--restart", good.string()}, dir / "bad.log"), 2);
+  EXPECT_NE(read(dir / "bad.log").find("is not the one checkpoint"), std::string::npos)
+      << read(dir / "bad.log");
+  // Nothing to run.
+  EXPECT_EQ(run_binary({"run"}, dir / "bad.log"), 2);
+}
