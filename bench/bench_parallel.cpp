@@ -3,6 +3,7 @@
 // walls, the top one down at 2 m/s, dt = 0.1 us, lumped Delassus operator): `warmup` steps, then
 // `steps` timed ones. Not a Google Benchmark (it runs under mpirun); rank 0 appends one CSV row:
 //   mpirun -np 2 build/release/bench/bench_parallel --scheme partition --threads 1 --csv out.csv
+// `--rebalance T --rebalance-every N` re-deals as `mpmcd run` does (default 0: never).
 // tools/scaling.py runs it over ranks, threads and both schemes. `--cpu-time 1` times the stages
 // in thread CPU time: on a shared, oversubscribed machine a rank's work without its waits.
 #include <fmt/format.h>
@@ -67,7 +68,8 @@ Setup make_packing() {
 
 int main(int argc, char** argv) {
   std::string scheme_name = "partition", csv;
-  int threads = 1, warmup = 50, steps = 50, cpu = 0;
+  int threads = 1, warmup = 50, steps = 50, cpu = 0, every = 25;
+  double threshold = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
     if (k == "--scheme")
@@ -82,6 +84,10 @@ int main(int argc, char** argv) {
       csv = v;
     else if (k == "--cpu-time")
       cpu = std::stoi(v);
+    else if (k == "--rebalance")
+      threshold = std::stod(v);
+    else if (k == "--rebalance-every")
+      every = std::stoi(v);
     else {
       std::cerr << "unknown option " << k << "\n";
       return 2;
@@ -124,6 +130,16 @@ int main(int argc, char** argv) {
       return 3;
     }
     solver.commit();
+    // Re-balancing as `mpmcd run` does it (partition scheme), its cost inside the timed steps.
+    if (comm.size() > 1 && scheme == parallel::Scheme::kPartition && threshold > 0 &&
+        (step + 1) % every == 0) {
+      mpmcd::ScopedStage ts(&solver.timers(), "rebalance");
+      auto owner = solver.owner();
+      bool moved = false;
+      parallel::rebalance(comm, model.points, model.grains, owner, solver.take_grain_work(),
+                          threshold, moved);
+      if (moved) solver.set_distribution(&comm, owner, scheme);
+    }
     if (step >= warmup) {
       contacts += static_cast<double>(st.contacts);
       sweeps += static_cast<double>(st.gs_sweeps);

@@ -14,8 +14,11 @@ schemes and on 1 rank with 2 threads, then writes to the output folder
   amdahl.csv           Amdahl projection S(P) = 1 / (f + (1 - f) / P) to P = 60 from the measured
                        serial fraction f at 2 ranks, both schemes
   scaling.png          speedup against processes (measured, ideal, Amdahl), like the paper's Fig. 2
+With --repeat N every configuration runs N times, the configurations alternating (a drifting
+machine load touches all of them alike); each figure is the median over the N runs, and
+speedup.csv also gives the smallest and largest speedup of the N paired rounds.
 Usage: tools/scaling.py [--build build/release] [--out scaling_out] [--ranks 1 2 4 8]
-                        [--warmup 30] [--steps 50] [--nice 10]"""
+                        [--warmup 30] [--steps 50] [--nice 10] [--repeat 1]"""
 import argparse, csv, os, subprocess, sys
 
 ap = argparse.ArgumentParser()
@@ -27,6 +30,7 @@ ap.add_argument("--schemes", nargs="+", default=["partition", "master"])
 ap.add_argument("--warmup", type=int, default=30)
 ap.add_argument("--steps", type=int, default=50)
 ap.add_argument("--nice", type=int, default=10)
+ap.add_argument("--repeat", type=int, default=1, help="rounds over all configurations (medians)")
 ap.add_argument("--cpu-time", action="store_true",
                 help="stage timers in thread CPU time (shared machine: work without core waits)")
 ap.add_argument("--plot-only", action="store_true", help="redraw from scaling_runs.csv")
@@ -53,15 +57,51 @@ def run(scheme, ranks, threads):
 if not a.plot_only:
     if os.path.exists(runs_csv):
         os.remove(runs_csv)
-    for scheme in a.schemes:
-        for ranks in a.ranks:
-            if ranks == 1 and scheme != a.schemes[0]:
-                continue  # one rank: the schemes are the same code path
-            run(scheme, ranks, 1)
-    for t in a.threads:
-        run(a.schemes[0], 1, t)
+    for _ in range(a.repeat):
+        for scheme in a.schemes:
+            for ranks in a.ranks:
+                if ranks == 1 and scheme != a.schemes[0]:
+                    continue  # one rank: the schemes are the same code path
+                run(scheme, ranks, 1)
+        for t in a.threads:
+            run(a.schemes[0], 1, t)
 
-rows = list(csv.DictReader(open(runs_csv)))
+
+def median(xs):
+    xs = sorted(xs)
+    n = len(xs)
+    return xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2])
+
+
+# Medians per configuration (scheme, ranks, threads) over the rounds; per stage too.
+raw = list(csv.DictReader(open(runs_csv)))
+raw_lines = open(runs_csv).read().splitlines()[1:]
+groups = {}
+for r, line in zip(raw, raw_lines):
+    groups.setdefault((r["scheme"], r["ranks"], r["threads"]), []).append((r, line))
+rows, lines, rounds = [], [], {}
+for key, members in groups.items():
+    med = dict(members[0][0])
+    for col in ("step_ms", "work_max_ms", "serial_fraction", "one_thread_fraction",
+                "bytes_per_rank_step", "bytes_max_rank_step", "contacts", "gs_sweeps",
+                "newton_it"):
+        med[col] = f"{median([float(r[col]) for r, _ in members]):.6g}"
+    stages = {}
+    for _, line in members:
+        for item in line.split(",")[14:]:
+            name, vals = item.split("=")
+            mean, ser = vals.split("/")
+            stages.setdefault(name, ([], []))
+            stages[name][0].append(float(mean))
+            stages[name][1].append(float(ser))
+    parts = [med[c] for c in ("scheme", "ranks", "threads", "points", "steps", "step_ms",
+                              "work_max_ms", "serial_fraction", "one_thread_fraction",
+                              "bytes_per_rank_step", "bytes_max_rank_step", "contacts",
+                              "gs_sweeps", "newton_it")]
+    parts += [f"{n}={median(m):.4f}/{median(sv):.4f}" for n, (m, sv) in sorted(stages.items())]
+    rows.append(med)
+    lines.append(",".join(parts))
+    rounds[key] = [float(m["step_ms"]) for m, _ in members]
 base = next(r for r in rows if r["ranks"] == "1" and r["threads"] == "1")
 t1 = float(base["step_ms"])
 out = []
@@ -70,17 +110,21 @@ for r in rows:
     p = int(r["ranks"]) * int(r["threads"])
     s = t1 / float(r["step_ms"])
     sw = float(base["work_max_ms"]) / float(r["work_max_ms"])
+    # Paired rounds: the k-th run of this configuration against the k-th serial run.
+    paired = [x / y for x, y in zip(rounds[(a.schemes[0], "1", "1")],
+                                    rounds[(r["scheme"], r["ranks"], r["threads"])])]
     out.append((sch, r["ranks"], r["threads"], r["step_ms"], f"{s:.3f}", f"{s / p:.3f}",
-                r["work_max_ms"], f"{sw:.3f}", f"{sw / p:.3f}"))
+                r["work_max_ms"], f"{sw:.3f}", f"{sw / p:.3f}", str(len(paired)),
+                f"{min(paired):.3f}", f"{max(paired):.3f}"))
 with open(os.path.join(a.out, "speedup.csv"), "w") as f:
     f.write("scheme,ranks,threads,step_ms,speedup,efficiency,work_max_ms,work_speedup,"
-            "work_efficiency\n")
+            "work_efficiency,runs,speedup_min,speedup_max\n")
     for o in out:
         f.write(",".join(o) + "\n")
 with open(os.path.join(a.out, "serial_stages.csv"), "w") as f:
     f.write("scheme,ranks,threads,stage,mean_ms_per_step,one_rank_alone_ms_per_step\n")
     # The stage column holds name=mean/serial pairs separated by commas after the fixed columns.
-    for line in open(runs_csv).read().splitlines()[1:]:
+    for line in lines:
         parts = line.split(",")
         for item in parts[14:]:
             name, vals = item.split("=")
@@ -95,7 +139,7 @@ with open(os.path.join(a.out, "bytes.csv"), "w") as f:
 # Amdahl's f = T_alone / T_1: the time per step in which one rank works alone (sum over top-level
 # stages of the largest work minus the second largest) over the one-rank step (work) time.
 alone = {}
-for line in open(runs_csv).read().splitlines()[1:]:
+for line in lines:
     parts = line.split(",")
     ms = 0.0
     for item in parts[14:]:
