@@ -40,6 +40,14 @@ runs_csv = os.path.join(a.out, "scaling_runs.csv")
 bench = os.path.join(a.build, "bench", "bench_parallel")
 
 
+def cpu_ticks():
+    """The 'cpu' line of /proc/stat (user nice system idle iowait irq softirq steal ...)."""
+    try:
+        return [int(x) for x in open("/proc/stat").readline().split()[1:]]
+    except OSError:
+        return None
+
+
 def run(scheme, ranks, threads):
     cmd = ["nice", "-n", str(a.nice)]
     if ranks > 1:
@@ -48,15 +56,22 @@ def run(scheme, ranks, threads):
     cmd += [bench, "--scheme", scheme, "--threads", str(threads), "--warmup", str(a.warmup),
             "--steps", str(a.steps), "--csv", runs_csv, "--cpu-time", "1" if a.cpu_time else "0"]
     print(" ".join(cmd), flush=True)
+    cpu0 = cpu_ticks()
     r = subprocess.run(cmd, capture_output=True, text=True)
+    cpu1 = cpu_ticks()
+    if cpu0 and cpu1:  # time the hypervisor gave to others while this run waited (steal)
+        d = [y - x for x, y in zip(cpu0, cpu1)]
+        with open(os.path.join(a.out, "steal.csv"), "a") as f:
+            f.write(f"{scheme},{ranks},{threads},{d[7] / max(sum(d), 1):.4f}\n")
     if r.returncode != 0:
         sys.exit(f"failed: {r.stderr[-2000:]}")
     print(r.stdout.strip().splitlines()[-1][:160], flush=True)
 
 
 if not a.plot_only:
-    if os.path.exists(runs_csv):
-        os.remove(runs_csv)
+    for f in (runs_csv, os.path.join(a.out, "steal.csv")):
+        if os.path.exists(f):
+            os.remove(f)
     for _ in range(a.repeat):
         for scheme in a.schemes:
             for ranks in a.ranks:
