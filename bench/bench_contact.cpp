@@ -7,56 +7,17 @@
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
-#include "mpmcd/materials/law.hpp"
-#include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
-#include "mpmcd/packing/packing.hpp"
-#include "mpmcd/packing/seeding.hpp"
+#include "slice_300.hpp"
 
 using namespace mpmcd;
 
 namespace {
 
-struct Setup {
-  mpm::Model<2> model;
-  std::vector<mpm::Wall<2>> walls;
-};
-
-Setup make_packing() {
-  packing::PackingParams pp;
-  pp.count = 300;
-  pp.diameter_min = 0.8e-3;
-  pp.diameter_max = 1.2e-3;
-  pp.target_phi = 0.78;
-  pp.seed = 42;
-  const packing::Packing pk = packing::generate_packing(pp);
-  Setup s;
-  const double h = packing::mean_diameter(pk) / 8;
-  const Vec<2> origin(pk.xmin - 2 * h, pk.ymin - 2 * h);
-  const IVec<2> cells(static_cast<std::int64_t>((pk.xmax - pk.xmin) / h) + 5,
-                      static_cast<std::int64_t>((pk.ymax - pk.ymin) / h) + 5);
-  s.model.grid = grid::Grid<2>(origin, h, cells);
-  s.model.add_material(materials::make_law<2>("neo_hookean", {{"lambda", 3e6}, {"mu", 1.5e6}}),
-                       990.0);
-  const auto seeded = packing::seed_packing(pk, origin, h, 2);
-  for (std::size_t k = 0; k < pk.disks.size(); ++k) {
-    points::Seeds<2> seeds;
-    seeds.x.assign(seeded.x.begin() + seeded.offset[k], seeded.x.begin() + seeded.offset[k + 1]);
-    seeds.volume.assign(seeded.volume.begin() + seeded.offset[k],
-                        seeded.volume.begin() + seeded.offset[k + 1]);
-    s.model.add_grain(seeds, 0, 0.25 * h, {});
-  }
-  s.walls = {{"bottom", Vec<2>(0, pk.ymin), Vec<2>(0, 1), Vec<2>::Zero(), 0.0},
-             {"top", Vec<2>(0, pk.ymax), Vec<2>(0, -1), Vec<2>(0, -2.0), 0.0},
-             {"left", Vec<2>(pk.xmin, 0), Vec<2>(1, 0), Vec<2>::Zero(), 0.0},
-             {"right", Vec<2>(pk.xmax, 0), Vec<2>(-1, 0), Vec<2>::Zero(), 0.0}};
-  return s;
-}
-
 void BM_ContactPacking(benchmark::State& state) {
   const auto kind = static_cast<mpm::LinearSolverKind>(state.range(0));
   omp_set_num_threads(static_cast<int>(state.range(1)));
-  Setup setup = make_packing();
+  bench::Slice setup = bench::make_slice_300();
   auto& model = setup.model;
   mpm::Settings<2> s;
   s.theta = 1.0;

@@ -1,7 +1,8 @@
-// Scaling of the parallel step (docs/parallel.md) on the 300-grain compaction slice of
-// bench_contact (DEM packing at phi = 0.78, d in [0.8, 1.2] mm, h = d/8, 2x2 points per cell, four
-// walls, the top one down at 2 m/s, dt = 0.1 us, lumped Delassus operator): `warmup` steps, then
-// `steps` timed ones. Not a Google Benchmark (it runs under mpirun); rank 0 appends one CSV row:
+// Scaling of the parallel step (docs/parallel.md) on the 300-grain compaction slice
+// (bench/slice_300.hpp: DEM packing at phi = 0.78, d in [0.8, 1.2] mm, h = d/8, 2x2 points per
+// cell, four walls, the top one down at 2 m/s, dt = 0.1 us, lumped Delassus operator): `warmup`
+// steps, then `steps` timed ones. Not a Google Benchmark (it runs under mpirun); rank 0 appends one
+// CSV row:
 //   mpirun -np 2 build/release/bench/bench_parallel --scheme partition --threads 1 --csv out.csv
 // `--rebalance T --rebalance-every N` re-deals as `mpmcd run` does (default 0: never).
 // tools/scaling.py runs it over ranks, threads and both schemes. `--cpu-time 1` times the stages
@@ -17,54 +18,11 @@
 #include <iostream>
 #include <string>
 
-#include "mpmcd/materials/law.hpp"
-#include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
-#include "mpmcd/packing/packing.hpp"
-#include "mpmcd/packing/seeding.hpp"
 #include "mpmcd/parallel/distribute.hpp"
+#include "slice_300.hpp"
 
 using namespace mpmcd;
-
-namespace {
-
-struct Setup {
-  mpm::Model<2> model;
-  std::vector<mpm::Wall<2>> walls;
-};
-
-Setup make_packing() {
-  packing::PackingParams pp;
-  pp.count = 300;
-  pp.diameter_min = 0.8e-3;
-  pp.diameter_max = 1.2e-3;
-  pp.target_phi = 0.78;
-  pp.seed = 42;
-  const packing::Packing pk = packing::generate_packing(pp);
-  Setup s;
-  const double h = packing::mean_diameter(pk) / 8;
-  const Vec<2> origin(pk.xmin - 2 * h, pk.ymin - 2 * h);
-  const IVec<2> cells(static_cast<std::int64_t>((pk.xmax - pk.xmin) / h) + 5,
-                      static_cast<std::int64_t>((pk.ymax - pk.ymin) / h) + 5);
-  s.model.grid = grid::Grid<2>(origin, h, cells);
-  s.model.add_material(materials::make_law<2>("neo_hookean", {{"lambda", 3e6}, {"mu", 1.5e6}}),
-                       990.0);
-  const auto seeded = packing::seed_packing(pk, origin, h, 2);
-  for (std::size_t k = 0; k < pk.disks.size(); ++k) {
-    points::Seeds<2> seeds;
-    seeds.x.assign(seeded.x.begin() + seeded.offset[k], seeded.x.begin() + seeded.offset[k + 1]);
-    seeds.volume.assign(seeded.volume.begin() + seeded.offset[k],
-                        seeded.volume.begin() + seeded.offset[k + 1]);
-    s.model.add_grain(seeds, 0, 0.25 * h, {});
-  }
-  s.walls = {{"bottom", Vec<2>(0, pk.ymin), Vec<2>(0, 1), Vec<2>::Zero(), 0.0},
-             {"top", Vec<2>(0, pk.ymax), Vec<2>(0, -1), Vec<2>(0, -2.0), 0.0},
-             {"left", Vec<2>(pk.xmin, 0), Vec<2>(1, 0), Vec<2>::Zero(), 0.0},
-             {"right", Vec<2>(pk.xmax, 0), Vec<2>(-1, 0), Vec<2>::Zero(), 0.0}};
-  return s;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   std::string scheme_name = "partition", csv;
@@ -96,7 +54,7 @@ int main(int argc, char** argv) {
   const auto& comm = parallel::Comm::world();
   omp_set_num_threads(threads);
   const auto scheme = parallel::scheme_from_string(scheme_name);
-  Setup setup = make_packing();
+  bench::Slice setup = bench::make_slice_300();
   auto& model = setup.model;
   mpm::Settings<2> s;
   s.theta = 1.0;
