@@ -56,8 +56,9 @@ int run_cli(int argc, char** argv) {
                   "with mpirun: partition (default) or master (docs/parallel.md)")
       ->check(CLI::IsMember({"partition", "master"}));
   run->add_option("--rebalance", run_opt.rebalance,
-                  "with mpirun, partition: re-deal the grains when the work imbalance max/mean "
-                  "exceeds this, checked every 50 steps (0: never; default 1.1)")
+                  "with mpirun, partition: re-deal the grains when the work imbalance (sum over "
+                  "phases of the largest rank's work over the mean) exceeds this, checked every "
+                  "50 steps (0: never; default 1.02)")
       ->check(CLI::NonNegativeNumber);
 
   std::string check_input;

@@ -621,8 +621,10 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   }
   if (keep) {
     std::vector<double> work(restart->grain_work);
-    for (std::size_t g = 0; g < work.size(); ++g)
-      if (restart->grain_owner[g] != comm.rank()) work[g] = 0;
+    for (std::size_t g = 0; g < restart->grain_owner.size(); ++g)
+      if (restart->grain_owner[g] != comm.rank())
+        std::fill_n(work.begin() + static_cast<std::ptrdiff_t>(g * parallel::kWorkPhases),
+                    parallel::kWorkPhases, 0.0);
     solver.set_grain_work(std::move(work));
   }
   std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
@@ -698,7 +700,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     }
     const auto all = comm.allgather(mine.bytes());
     std::vector<double> work = solver.grain_work();
-    work.resize(model.grains.size(), 0.0);
+    work.resize(model.grains.size() * parallel::kWorkPhases, 0.0);
     comm.sum(work);
     last_checkpoint_step = summary.steps;
     if (!root) return std::string();
@@ -792,6 +794,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     return path;
   };
   if (!restart) record(true);
+  comm.record_syncs();  // the serial fraction, measured at every synchronisation
   const auto wall0 = std::chrono::steady_clock::now();
   auto last_progress = wall0, last_checkpoint_wall = wall0;
   const std::int64_t steps0 = summary.steps;
@@ -907,10 +910,11 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   // Per-stage timers over ranks with the serial shares (docs/parallel.md): <name>_timers.csv.
   std::vector<double> bytes{static_cast<double>(comm.bytes_sent())};
   comm.sum(bytes);
+  const auto solo = comm.solo_report();
   const auto report = parallel::stage_report(comm, solver.timers().totals());
   const std::string csv = parallel::stage_report_csv(
       report, summary.wall_seconds, comm.size(), omp_get_max_threads(), summary.steps - steps0,
-      bytes[0] / comm.size() / std::max<std::int64_t>(summary.steps - steps0, 1));
+      bytes[0] / comm.size() / std::max<std::int64_t>(summary.steps - steps0, 1), solo);
   if (root) {
     io::write_file_atomic(
         (fs::path(summary.output_dir) / (cfg.simulation.name + "_timers.csv")).string(), csv);

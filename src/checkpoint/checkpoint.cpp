@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "mpmcd/core/errors.hpp"
+#include "mpmcd/parallel/partition.hpp"
 #include "mpmcd/version.hpp"
 
 namespace mpmcd::checkpoint {
@@ -338,7 +339,7 @@ void write(const State& s, const std::string& path) {
     w.scalar("/parallel/ranks", s.ranks);
     w.text("/parallel/scheme", s.scheme);
     w.array("/parallel/grain_owner", s.grain_owner, {ng});
-    w.array("/parallel/grain_work", s.grain_work, {ng});
+    w.array("/parallel/grain_work", s.grain_work, {ng, parallel::kWorkPhases});
     w.close();
   }
   // The user block: header with the size and checksum of everything after it.
@@ -455,7 +456,7 @@ State read(const std::string& path) {
   s.ranks = r.scalar<std::int32_t>("/parallel/ranks");
   s.scheme = r.text("/parallel/scheme");
   s.grain_owner = r.array<std::int32_t>("/parallel/grain_owner", {ng});
-  s.grain_work = r.array<double>("/parallel/grain_work", {ng});
+  s.grain_work = r.array<double>("/parallel/grain_work", {ng, parallel::kWorkPhases});
   // 3. Consistency and the payload checksum.
   if (r.scalar<std::uint64_t>("/meta/payload_checksum") != payload_checksum(s))
     r.fail("/meta/payload_checksum", "payload checksum mismatch (corrupted data)");
@@ -479,10 +480,13 @@ State read(const std::string& path) {
   if (s.ranks < 1) r.fail("/parallel/ranks", fmt::format("{} ranks", s.ranks));
   if (s.scheme != "partition" && s.scheme != "master")
     r.fail("/parallel/scheme", fmt::format("unknown scheme '{}'", s.scheme));
-  for (std::size_t g = 0; g < ng; ++g)
-    if (s.grain_owner[g] < 0 || s.grain_owner[g] >= s.ranks || !(s.grain_work[g] >= 0))
-      r.fail("/parallel", fmt::format("grain {} has owner {} of {} ranks or work {}", g,
-                                      s.grain_owner[g], s.ranks, s.grain_work[g]));
+  for (std::size_t g = 0; g < ng; ++g) {
+    const double* work = &s.grain_work[g * parallel::kWorkPhases];
+    if (s.grain_owner[g] < 0 || s.grain_owner[g] >= s.ranks ||
+        !std::all_of(work, work + parallel::kWorkPhases, [](double x) { return x >= 0; }))
+      r.fail("/parallel", fmt::format("grain {} has owner {} of {} ranks or a negative work", g,
+                                      s.grain_owner[g], s.ranks));
+  }
   return s;
 }
 

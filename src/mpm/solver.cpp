@@ -71,6 +71,7 @@ struct ImplicitSolver<Dim>::GrainWork {
   bool converged = false, solved_once = false;
   int iterations = 0;
   std::int64_t solves = 0;
+  double cg_work = 0;  // CG iterations x matrix non-zeros of the last solve [-]
   double res_norm = 0, res_ref = 0, dv_norm = 0;
   std::vector<double> history;  // |R| / reference per iteration
   std::string failure;
@@ -565,6 +566,9 @@ void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt) {
   for (std::size_t a = 0; a < na; ++a)
     for (int d = 0; d < Dim; ++d) w.rhs[a * Dim + d] = -w.R[a][d];
   w.sol = linear_solve(g, w.rhs);
+  w.cg_work = settings_.linear_solver == LinearSolverKind::kCg
+                  ? static_cast<double>(w.cg.iterations()) * static_cast<double>(w.A.nonZeros())
+                  : static_cast<double>(w.A.nonZeros());
   if (!w.sol.allFinite()) {
     w.failure = "linear solve failed (singular or indefinite tangent)";
     return;
@@ -635,6 +639,16 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         setup_grain<grid::UGimp1D>(g, dt);
     }
   }
+  // Work counts (docs/parallel.md): per grain and phase for re-balancing, where P2G, detection
+  // and G2P go with the first Newton iteration; per synchronisation for the counted serial
+  // fraction (Comm::count_work).
+  grain_work_.resize(ng * parallel::kWorkPhases, 0.0);
+  double owned_points = 0;
+  for (std::size_t g : owned_) {
+    phase_work(g, 0) += kSetupWorkWeight * static_cast<double>(grains_[g].size());
+    owned_points += static_cast<double>(grains_[g].size());
+  }
+  if (dist) comm_->count_work(kP2gWorkWeight * owned_points);
   if (collect_failure()) return stats;
   const bool contact = settings_.contact.enabled;
   if (contact && dist) {
@@ -645,6 +659,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     ScopedStage t(&timers_, "contact.detect");
     detect_contacts(dt);
     if (dist) {
+      comm_->count_work(kDetectItemWeight * detect_items_);
       ScopedStage tc(&timers_, "contact.detect.comm");
       exchange_requests();
     } else {
@@ -659,7 +674,8 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   for (int it = 0; it <= settings_.max_iterations; ++it) {
     {
       ScopedStage t(&timers_, "newton.assemble");
-#pragma omp parallel for schedule(dynamic, 1) if (no > 1)
+      double units = 0;
+#pragma omp parallel for schedule(dynamic, 1) if (no > 1) reduction(+ : units)
       for (std::size_t i = 0; i < no; ++i) {
         const std::size_t g = owned_[i];
         GrainWork& w = *work_[g];
@@ -669,7 +685,11 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         else
           evaluate_grain<grid::UGimp1D>(g, dt);
         if (w.failure.empty()) w.iterations = it;
+        const auto u = static_cast<double>(grains_[g].size());
+        phase_work(g, it) += u;
+        units += u;
       }
+      if (dist) comm_->count_work(units);
     }
     if (collect_failure()) return stats;
     // Convergence of each evaluated grain: |R| <= tol * reference and |dv|_M <= tol * velocity
@@ -723,7 +743,8 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     if (it == settings_.max_iterations) break;
     {
       ScopedStage t(&timers_, "newton.solve");
-#pragma omp parallel for schedule(dynamic, 1) if (no > 1)
+      double units = 0;
+#pragma omp parallel for schedule(dynamic, 1) if (no > 1) reduction(+ : units)
       for (std::size_t i = 0; i < no; ++i) {
         const std::size_t g = owned_[i];
         GrainWork& w = *work_[g];
@@ -735,7 +756,11 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
             assemble_tangent<grid::UGimp1D>(g);
         }
         solve_grain(g, dt);
+        const double u = kCgWorkWeight * w.cg_work;
+        phase_work(g, it) += u;
+        units += u;
       }
+      if (dist) comm_->count_work(units);
     }
     if (collect_failure()) return stats;
     if (have_contacts_) {
@@ -743,11 +768,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       impulse_change = dist ? update_contacts_distributed(stats) : update_contacts(stats);
     }
   }
-  grain_work_.resize(ng, 0.0);
   for (std::size_t g : owned_) {
     stats.iterations = std::max(stats.iterations, work_[g]->iterations);
     stats.linear_solves += work_[g]->solves;
-    grain_work_[g] += static_cast<double>(grains_[g].size()) * (1 + work_[g]->iterations);
   }
   if (!stats.converged) {
     for (std::size_t g : owned_)
@@ -907,7 +930,9 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   };
   std::vector<std::vector<Candidate>> found(shared.size());
   const auto nshared = static_cast<std::int64_t>(shared.size());
-#pragma omp parallel for schedule(dynamic, 32) if (nshared > 256)
+  // Work count (Comm::count_work): node fields, pairs and point pairs of the gaps examined here.
+  double items = static_cast<double>(entries.size());
+#pragma omp parallel for schedule(dynamic, 32) if (nshared > 256) reduction(+ : items)
   for (std::int64_t i = 0; i < nshared; ++i) {
     const std::int64_t n = shared[i];
     if (node_rank(n) != me) continue;
@@ -917,6 +942,8 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         if (A.g > B.g) std::swap(A, B);
         const GrainWork& wa = *work_[A.g];
         const GrainWork& wb = *work_[B.g];
+        items += 1.0 + (wa.node_pts_start[A.a + 1] - wa.node_pts_start[A.a]) *
+                           (wb.node_pts_start[B.a + 1] - wb.node_pts_start[B.a]);
         // Normal from A to B (method.md §4). g^X = sum_p m_p grad N_I(x_p) points OUT of grain X
         // (grad N_I at a point points toward the node), i.e. it is minus the gradient of X's mass
         // density, so n ∝ grad rho^B - grad rho^A = g^A - g^B.
@@ -970,6 +997,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         if (dist && node_rank(w.node_global[a]) != me) continue;
         const Vec<Dim> xn = grid_.node_position(grid_.node_coords(w.node_global[a]));
         if (wall.distance(xn, time_) > cs.wall_range * h) continue;
+        items += 1.0 + (w.node_pts_start[a + 1] - w.node_pts_start[a]);
         double gap = std::numeric_limits<double>::infinity(), ext = 0;
         for (std::int32_t k = w.node_pts_start[a]; k < w.node_pts_start[a + 1]; ++k) {
           const std::int64_t p = grains_[g].begin + w.node_pts[k];
@@ -998,6 +1026,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
       }
     }
   }
+  detect_items_ = items;
   // Warm start: the grains see the previous step's impulses from the first iteration on.
   std::vector<Vec<Dim>> slot_p(problem_.slots.size(), Vec<Dim>::Zero());
   for (const auto& c : problem_.contacts) {
@@ -1252,10 +1281,16 @@ void ImplicitSolver<Dim>::set_distribution(const parallel::Comm* comm, std::vect
 
 template <int Dim>
 std::vector<double> ImplicitSolver<Dim>::take_grain_work() {
-  std::vector<double> w(grains_.size(), 0.0);
-  grain_work_.resize(grains_.size(), 0.0);
+  std::vector<double> w(grains_.size() * parallel::kWorkPhases, 0.0);
+  grain_work_.resize(w.size(), 0.0);
   w.swap(grain_work_);
   return w;
+}
+
+template <int Dim>
+double& ImplicitSolver<Dim>::phase_work(std::size_t g, int iteration) {
+  return grain_work_[g * parallel::kWorkPhases +
+                     static_cast<std::size_t>(std::min(iteration, parallel::kWorkPhases - 1))];
 }
 
 template <int Dim>
@@ -1506,7 +1541,13 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
   // error summed over ranks before every test (partition); all contacts on rank 0 (master).
   contact::GsResult r;
   if (scheme_ == parallel::Scheme::kPartition) {
+    // Counted work before each error test: one pass over this rank's contacts for the first
+    // test, two (the sweep and its error) for the others.
+    double passes = 1;
     const contact::ErrorReduce reduce = [&](double& num, double& den) {
+      comm_->count_work(kContactPassWeight * passes *
+                        static_cast<double>(problem_.contacts.size()));
+      passes = 2;
       ScopedStage tc(&timers_, "contact.solve.comm");
       std::vector<double> v{num, den};
       comm_->sum(v);
@@ -1520,6 +1561,8 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
     if (comm_->rank() == 0) {
       ScopedStage t(&timers_, "contact.gs");
       r = contact::solve_gauss_seidel(problem_, settings_.contact.gs);
+      comm_->count_work(kContactPassWeight * (1.0 + 2.0 * r.sweeps) *
+                        static_cast<double>(problem_.contacts.size()));
     }
     ScopedStage tc(&timers_, "contact.solve.comm");
     std::vector<double> v{static_cast<double>(r.sweeps), r.error, r.converged ? 0.0 : 1.0};

@@ -208,23 +208,27 @@ double rebalance(const Comm& comm, points::PointSet<Dim>& points,
                  const std::vector<double>& weights, double threshold, bool& moved) {
   moved = false;
   const std::size_t ng = grains.size();
+  constexpr std::size_t K = kWorkPhases;
+  if (weights.size() != K * ng)
+    throw std::logic_error("rebalance: expected kWorkPhases weights per grain");
   // Weights and centroids of every grain (each rank fills its own; sums in rank order).
-  std::vector<double> data(3 * ng, 0.0);
+  std::vector<double> data((K + 2) * ng, 0.0);
+  const std::size_t cx = K * ng;  // centroids after the weights
   for (std::size_t g = 0; g < ng; ++g) {
     if (owner[g] != comm.rank()) continue;
-    data[g] = weights[g];
+    for (std::size_t k = 0; k < K; ++k) data[K * g + k] = weights[K * g + k];
     for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p)
-      for (int d = 0; d < std::min(Dim, 2); ++d) data[ng + 2 * g + d] += points.x[p][d];
+      for (int d = 0; d < std::min(Dim, 2); ++d) data[cx + 2 * g + d] += points.x[p][d];
     for (int d = 0; d < 2; ++d)
-      data[ng + 2 * g + d] /= static_cast<double>(std::max<std::int64_t>(grains[g].size(), 1));
+      data[cx + 2 * g + d] /= static_cast<double>(std::max<std::int64_t>(grains[g].size(), 1));
   }
   comm.sum(data);
-  const std::vector<double> w(data.begin(), data.begin() + static_cast<std::ptrdiff_t>(ng));
-  const double before = imbalance(owner, w, comm.size());
+  const std::vector<double> w(data.begin(), data.begin() + static_cast<std::ptrdiff_t>(cx));
+  const double before = imbalance(owner, w, comm.size(), K);
   if (before <= threshold || comm.size() == 1) return before;
   std::vector<std::array<double, 2>> c(ng);
-  for (std::size_t g = 0; g < ng; ++g) c[g] = {data[ng + 2 * g], data[ng + 2 * g + 1]};
-  const std::vector<int> next = bisection(c, w, comm.size());
+  for (std::size_t g = 0; g < ng; ++g) c[g] = {data[cx + 2 * g], data[cx + 2 * g + 1]};
+  const std::vector<int> next = bisection(c, w, comm.size(), K);
   std::map<int, Buffer> out;
   std::set<int> from;
   for (std::size_t g = 0; g < ng; ++g) {
@@ -304,21 +308,31 @@ std::vector<StageTime> stage_report(const Comm& comm, const std::map<std::string
 }
 
 std::string stage_report_csv(const std::vector<StageTime>& rows, double wall_seconds, int ranks,
-                             int threads, long long steps, double bytes_per_rank_step) {
+                             int threads, long long steps, double bytes_per_rank_step,
+                             const Comm::SoloReport& solo) {
   std::string out = "stage,max_s,mean_s,min_s,work_serial_s,nested,one_thread\n";
-  double serial = 0, one = 0;
+  double imbalance = 0, one = 0;
   for (const auto& s : rows) {
     out += fmt::format("{},{:.6e},{:.6e},{:.6e},{:.6e},{},{}\n", s.name, s.max, s.mean, s.min,
                        s.serial, s.nested ? 1 : 0, s.one_thread ? 1 : 0);
-    if (!s.nested) serial += s.serial;
+    if (!s.nested) imbalance += s.serial;
     if (!s.nested && s.one_thread && threads > 1) one += s.mean;
   }
   const double w = std::max(wall_seconds, 1e-300);
   out += fmt::format("# ranks,{}\n# threads,{}\n# steps,{}\n# wall_s,{:.6e}\n", ranks, threads,
                      steps, wall_seconds);
-  out += fmt::format("# one_rank_serial_fraction,{:.6e}\n# one_thread_fraction,{:.6e}\n",
-                     serial / w, one / w);
+  // The serial fraction is measured at every synchronisation (Comm::solo_report); the sum of
+  // the stages' imbalances is a lower bound on it, kept for comparison.
+  out += fmt::format("# one_rank_serial_fraction,{:.6e}\n# one_rank_serial_fraction_cpu,{:.6e}\n",
+                     solo.solo_s / w, solo.solo_cpu_s / w);
+  out += fmt::format("# stage_imbalance_fraction,{:.6e}\n", imbalance / w);
+  out += fmt::format("# counted_serial_fraction,{:.6e}\n", solo.solo_work_fraction);
+  out += fmt::format("# sync_wait_fraction,{:.6e}\n# syncs,{}\n# syncs_consistent,{}\n",
+                     solo.wait_s / w, solo.syncs, solo.consistent ? 1 : 0);
+  out += fmt::format("# one_thread_fraction,{:.6e}\n", one / w);
   out += fmt::format("# bytes_sent_per_rank_per_step,{:.6e}\n", bytes_per_rank_step);
+  for (const auto& [site, secs] : solo.by_site)
+    out += fmt::format("# solo_s_at,{},{:.6e}\n", site, secs);
   return out;
 }
 

@@ -12,7 +12,7 @@
 namespace mpmcd::checkpoint {
 
 /// Layout version of the files this build writes and reads [-].
-inline constexpr std::int32_t kFormatVersion = 2;
+inline constexpr std::int32_t kFormatVersion = 3;
 
 /// FNV-1a 64-bit offset basis (start value of fnv1a) [-].
 inline constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
@@ -71,7 +71,8 @@ struct State {
   std::int32_t ranks = 1;                 ///< MPI ranks of the writing run [-]
   std::string scheme = "partition";       ///< parallel scheme of the writing run [-]
   std::vector<std::int32_t> grain_owner;  ///< rank owning each grain, per grain [-]
-  std::vector<double> grain_work;         ///< re-balancing work since the last check, per grain [-]
+  /// Re-balancing work since the last check, grain x parallel::kWorkPhases (grain-major) [-].
+  std::vector<double> grain_work;
 
   /// Number of material points [-].
   std::size_t points() const { return grain.size(); }

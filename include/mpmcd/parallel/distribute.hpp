@@ -35,10 +35,11 @@ contact::Problem<Dim> gather_contacts(const Comm& comm, const contact::Problem<D
                                       int root);
 
 /// Re-balancing of the partition scheme: with `weights` the work of each owned grain since the
-/// last call (0 for others; deterministic, e.g. points x Newton iterations), the imbalance
-/// max/mean of the ranks' sums; above `threshold` the grains are bisected again at their current
-/// centroids with those weights, and each grain whose rank changes is sent (committed state) from
-/// its old to its new owner. Collective; returns the imbalance measured before [-].
+/// last call, kWorkPhases values per grain (0 for others; deterministic counts, see
+/// ImplicitSolver::take_grain_work), the imbalance (partition.hpp) of the ranks' sums per phase;
+/// above `threshold` the grains are bisected again at their current centroids with those weights,
+/// and each grain whose rank changes is sent (committed state) from its old to its new owner.
+/// Collective; returns the imbalance measured before [-].
 template <int Dim>
 double rebalance(const Comm& comm, points::PointSet<Dim>& points,
                  const std::vector<points::Grain>& grains, std::vector<int>& owner,
@@ -50,7 +51,7 @@ struct StageTime {
   double max = 0;           ///< largest time over ranks [s]
   double mean = 0;          ///< mean over ranks [s]
   double min = 0;           ///< smallest over ranks [s]
-  double serial = 0;        ///< work done by one rank alone: max - second largest of work [s]
+  double serial = 0;        ///< stage-total imbalance: max - second largest of work [s]
   bool nested = false;      ///< inside another stage (not added to the step total)
   bool one_thread = false;  ///< runs on one thread per rank
 };
@@ -59,8 +60,11 @@ struct StageTime {
 std::vector<StageTime> stage_report(const Comm& comm, const std::map<std::string, double>& totals);
 
 /// The report as CSV: stage,max_s,mean_s,min_s,work_serial_s,nested,one_thread, then summary
-/// rows (wall, serial fraction of one rank, one-thread share, bytes sent per rank per step).
+/// rows: wall, serial fraction of one rank (from `solo`, synchronisation by synchronisation),
+/// stage-total imbalance, time in synchronisations, one-thread share, bytes sent per rank per
+/// step, and the solo time of each synchronising code line.
 std::string stage_report_csv(const std::vector<StageTime>& rows, double wall_seconds, int ranks,
-                             int threads, long long steps, double bytes_per_rank_step);
+                             int threads, long long steps, double bytes_per_rank_step,
+                             const Comm::SoloReport& solo);
 
 }  // namespace mpmcd::parallel

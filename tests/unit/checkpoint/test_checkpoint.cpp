@@ -75,7 +75,7 @@ ck::State sample() {
   s.ranks = 2;
   s.scheme = "partition";
   s.grain_owner = {1, 0};
-  s.grain_work = {3.0 * 4, 0.5};
+  s.grain_work = {3.0 * 4, 0.5, 0, 1, 2, 3, 4, 5};
   return s;
 }
 
