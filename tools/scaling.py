@@ -2,23 +2,30 @@
 """Scaling benchmark of the parallel step (docs/parallel.md): runs bench/bench_parallel (the
 300-grain compaction slice) on 1, 2, 4, 8 ranks (oversubscribed where cores are short) for both
 schemes and on 1 rank with 2 threads, then writes to the output folder
-  scaling_runs.csv     one row per run (bench_parallel's row: step time, serial fraction, bytes)
+  scaling_runs.csv     one row per run (bench_parallel's row: step time, serial fractions, bytes)
   speedup.csv          scheme, ranks, threads, step_ms, speedup, efficiency, and the work-based
                        speedup (serial step / largest rank's work per step: the step time of a
                        machine where no rank waits for a core; a shared, loaded machine inflates
                        the measured wall time, not this)
-  serial_stages.csv    per scheme and rank count: per-stage mean time and one-rank-alone time [ms/step]
-  bytes.csv            bytes sent per rank per step (mean and largest rank), per scheme and ranks
+  serial_stages.csv    per scheme and rank count: per-stage mean time and stage-total imbalance
+                       (largest minus second largest rank's work over the run) [ms/step]
+  bytes.csv            bytes sent per rank per step (mean, largest rank, re-balancing), per scheme
   serial_fraction.csv  per scheme and rank count: time per step in which one rank works alone,
-                       and as a fraction of the one-rank step (Amdahl's f)
-  amdahl.csv           Amdahl projection S(P) = 1 / (f + (1 - f) / P) to P = 60 from the measured
-                       serial fraction f at 2 ranks, both schemes
+                       measured at every synchronisation in wall and in CPU time, as a fraction of
+                       the one-rank step (Amdahl's f), and the counted serial fraction (the same
+                       in deterministic work units, free of the machine's timing noise); the
+                       `mirror` row is the machine's floor: two ranks doing identical work with one
+                       synchronisation per step
+  amdahl.csv           Amdahl projection S(P) = 1 / (f + (1 - f) / P) to P = 60 from the serial
+                       fraction f at 2 ranks (measured and counted), both schemes
   scaling.png          speedup against processes (measured, ideal, Amdahl), like the paper's Fig. 2
 With --repeat N every configuration runs N times, the configurations alternating (a drifting
 machine load touches all of them alike); each figure is the median over the N runs, and
 speedup.csv also gives the smallest and largest speedup of the N paired rounds.
+The partition runs re-balance as `mpmcd run` does (--rebalance 1.01 every 50 steps); the default
+warm-up of 60 steps includes the first re-balancing.
 Usage: tools/scaling.py [--build build/release] [--out scaling_out] [--ranks 1 2 4 8]
-                        [--warmup 30] [--steps 50] [--nice 10] [--repeat 1]"""
+                        [--warmup 60] [--steps 50] [--nice 10] [--repeat 1] [--rebalance 1.01]"""
 import argparse, csv, os, subprocess, sys
 
 ap = argparse.ArgumentParser()
@@ -27,10 +34,11 @@ ap.add_argument("--out", default="scaling_out")
 ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 4, 8])
 ap.add_argument("--threads", type=int, nargs="+", default=[2], help="threads on 1 rank")
 ap.add_argument("--schemes", nargs="+", default=["partition", "master"])
-ap.add_argument("--warmup", type=int, default=30)
+ap.add_argument("--warmup", type=int, default=60)
 ap.add_argument("--steps", type=int, default=50)
 ap.add_argument("--nice", type=int, default=10)
 ap.add_argument("--repeat", type=int, default=1, help="rounds over all configurations (medians)")
+ap.add_argument("--rebalance", type=float, default=1.01, help="partition: threshold (0: never)")
 ap.add_argument("--cpu-time", action="store_true",
                 help="stage timers in thread CPU time (shared machine: work without core waits)")
 ap.add_argument("--plot-only", action="store_true", help="redraw from scaling_runs.csv")
@@ -48,13 +56,17 @@ def cpu_ticks():
         return None
 
 
-def run(scheme, ranks, threads):
+def run(scheme, ranks, threads, mirror=False):
     cmd = ["nice", "-n", str(a.nice)]
     if ranks > 1:
         cmd += ["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none",
                 "-np", str(ranks)]
     cmd += [bench, "--scheme", scheme, "--threads", str(threads), "--warmup", str(a.warmup),
             "--steps", str(a.steps), "--csv", runs_csv, "--cpu-time", "1" if a.cpu_time else "0"]
+    if scheme == "partition" and ranks > 1 and not mirror:
+        cmd += ["--rebalance", str(a.rebalance), "--rebalance-every", "50"]
+    if mirror:
+        cmd += ["--mirror", "1"]
     print(" ".join(cmd), flush=True)
     cpu0 = cpu_ticks()
     r = subprocess.run(cmd, capture_output=True, text=True)
@@ -80,6 +92,7 @@ if not a.plot_only:
                 run(scheme, ranks, 1)
         for t in a.threads:
             run(a.schemes[0], 1, t)
+        run(a.schemes[0], 2, 1, mirror=True)  # the machine's floor for the serial fraction
 
 
 def median(xs):
@@ -90,6 +103,10 @@ def median(xs):
 
 # Medians per configuration (scheme, ranks, threads) over the rounds; per stage too.
 raw = list(csv.DictReader(open(runs_csv)))
+HEADER = open(runs_csv).readline().strip().split(",")
+FIXED = HEADER[:-1]  # the last header field, "stages", spans the rest of the row
+NSTAGE = len(FIXED)
+NUMERIC = [c for c in FIXED if c not in ("scheme", "ranks", "threads", "points", "steps")]
 raw_lines = open(runs_csv).read().splitlines()[1:]
 groups = {}
 for r, line in zip(raw, raw_lines):
@@ -97,26 +114,24 @@ for r, line in zip(raw, raw_lines):
 rows, lines, rounds = [], [], {}
 for key, members in groups.items():
     med = dict(members[0][0])
-    for col in ("step_ms", "work_max_ms", "serial_fraction", "one_thread_fraction",
-                "bytes_per_rank_step", "bytes_max_rank_step", "contacts", "gs_sweeps",
-                "newton_it"):
+    for col in NUMERIC:
         med[col] = f"{median([float(r[col]) for r, _ in members]):.6g}"
     stages = {}
     for _, line in members:
-        for item in line.split(",")[14:]:
+        for item in line.split(",")[NSTAGE:]:
             name, vals = item.split("=")
             mean, ser = vals.split("/")
             stages.setdefault(name, ([], []))
             stages[name][0].append(float(mean))
             stages[name][1].append(float(ser))
-    parts = [med[c] for c in ("scheme", "ranks", "threads", "points", "steps", "step_ms",
-                              "work_max_ms", "serial_fraction", "one_thread_fraction",
-                              "bytes_per_rank_step", "bytes_max_rank_step", "contacts",
-                              "gs_sweeps", "newton_it")]
+    parts = [med[c] for c in FIXED]
     parts += [f"{n}={median(m):.4f}/{median(sv):.4f}" for n, (m, sv) in sorted(stages.items())]
     rows.append(med)
     lines.append(",".join(parts))
     rounds[key] = [float(m["step_ms"]) for m, _ in members]
+floor = [r for r in rows if r["scheme"] == "mirror"]
+rows = [r for r in rows if r["scheme"] != "mirror"]
+lines = [ln for ln in lines if not ln.startswith("mirror,")]
 base = next(r for r in rows if r["ranks"] == "1" and r["threads"] == "1")
 t1 = float(base["step_ms"])
 out = []
@@ -137,47 +152,44 @@ with open(os.path.join(a.out, "speedup.csv"), "w") as f:
     for o in out:
         f.write(",".join(o) + "\n")
 with open(os.path.join(a.out, "serial_stages.csv"), "w") as f:
-    f.write("scheme,ranks,threads,stage,mean_ms_per_step,one_rank_alone_ms_per_step\n")
+    f.write("scheme,ranks,threads,stage,mean_ms_per_step,stage_imbalance_ms_per_step\n")
     # The stage column holds name=mean/serial pairs separated by commas after the fixed columns.
     for line in lines:
         parts = line.split(",")
-        for item in parts[14:]:
+        for item in parts[NSTAGE:]:
             name, vals = item.split("=")
             mean, ser = vals.split("/")
             f.write(f"{parts[0]},{parts[1]},{parts[2]},{name},{mean},{ser}\n")
 with open(os.path.join(a.out, "bytes.csv"), "w") as f:
-    f.write("scheme,ranks,bytes_per_rank_step,bytes_max_rank_step\n")
+    f.write("scheme,ranks,bytes_per_rank_step,bytes_max_rank_step,rebalance_bytes_per_rank_step\n")
     for r in rows:
         if r["threads"] == "1":
             f.write(f"{r['scheme']},{r['ranks']},{r['bytes_per_rank_step']},"
-                    f"{r['bytes_max_rank_step']}\n")
-# Amdahl's f = T_alone / T_1: the time per step in which one rank works alone (sum over top-level
-# stages of the largest work minus the second largest) over the one-rank step (work) time.
-alone = {}
-for line in lines:
-    parts = line.split(",")
-    ms = 0.0
-    for item in parts[14:]:
-        name, vals = item.split("=")
-        if name.endswith(".comm") or name == "contact.gs":
-            continue  # nested in another stage
-        ms += float(vals.split("/")[1])
-    alone[(parts[0], parts[1], parts[2])] = ms
-fs = {}
-for r in rows:
-    if r["ranks"] == "2" and r["threads"] == "1":
-        fs[r["scheme"]] = alone[(r["scheme"], "2", "1")] / float(base["work_max_ms"])
+                    f"{r['bytes_max_rank_step']},{r['rebalance_bytes_per_rank_step']}\n")
+# Amdahl's f = T_alone / T_1: the time per step in which one rank works alone, measured at every
+# synchronisation (wall and CPU time), over the one-rank step; and the counted fraction.
+T1 = float(base["step_ms"])
+fs, fc = {}, {}
 with open(os.path.join(a.out, "serial_fraction.csv"), "w") as f:
-    f.write("scheme,ranks,one_rank_alone_ms_per_step,serial_fraction_of_1_rank_step\n")
-    for (sch, rk, th), ms in sorted(alone.items()):
-        if th == "1" and rk != "1":
-            f.write(f"{sch},{rk},{ms:.4f},{ms / float(base['work_max_ms']):.4f}\n")
+    f.write("scheme,ranks,solo_ms_per_step,solo_cpu_ms_per_step,serial_fraction_wall,"
+            "serial_fraction_cpu,counted_serial_fraction,stage_imbalance_ms_per_step\n")
+    for r in sorted(rows + floor, key=lambda r: (r["scheme"], int(r["ranks"]))):
+        if r["threads"] != "1" or r["ranks"] == "1":
+            continue
+        solo, cpu = float(r["solo_ms"]), float(r["solo_cpu_ms"])
+        imb = float(r["stage_imbalance_fraction"]) * float(r["step_ms"])
+        f.write(f"{r['scheme']},{r['ranks']},{solo:.4f},{cpu:.4f},{solo / T1:.4f},"
+                f"{cpu / T1:.4f},{float(r['counted_serial_fraction']):.4f},{imb:.4f}\n")
+        if r["ranks"] == "2" and r["scheme"] != "mirror":
+            fs[r["scheme"]] = solo / T1
+            fc[r["scheme"]] = float(r["counted_serial_fraction"])
 P = list(range(1, 61))
 with open(os.path.join(a.out, "amdahl.csv"), "w") as f:
-    f.write("scheme,serial_fraction,S2,S8,S60,E60\n")
-    for sch, fr in fs.items():
-        S = lambda p: 1 / (fr + (1 - fr) / p)
-        f.write(f"{sch},{fr:.4f},{S(2):.2f},{S(8):.2f},{S(60):.2f},{S(60) / 60:.3f}\n")
+    f.write("scheme,f_from,serial_fraction,S2,S8,S60,E60\n")
+    for src, table in (("measured", fs), ("counted", fc)):
+        for sch, fr in table.items():
+            S = lambda p: 1 / (fr + (1 - fr) / p)
+            f.write(f"{sch},{src},{fr:.4f},{S(2):.2f},{S(8):.2f},{S(60):.2f},{S(60) / 60:.3f}\n")
 print(open(os.path.join(a.out, "speedup.csv")).read())
 print(open(os.path.join(a.out, "bytes.csv")).read())
 print(open(os.path.join(a.out, "serial_fraction.csv")).read())
@@ -197,10 +209,11 @@ try:
         if len(pts) > 1:
             ax.plot(*zip(*pts), mark + "-", label=f"{sch}: wall time (shared machine)")
             ax.plot(*zip(*wpts), mark + ":", mfc="none", label=f"{sch}: largest rank's work")
-        if sch in fs:
-            fr = fs[sch]
-            ax.plot(P, [1 / (fr + (1 - fr) / p) for p in P], "--",
-                    label=f"{sch}: Amdahl, f = {100 * fr:.1f} %")
+        for src, table, style in (("measured", fs, "--"), ("counted", fc, "-.")):
+            if sch in table:
+                fr = table[sch]
+                ax.plot(P, [1 / (fr + (1 - fr) / p) for p in P], style,
+                        label=f"{sch}: Amdahl, {src} f = {100 * fr:.1f} %")
     thr = [(int(r["threads"]), t1 / float(r["step_ms"])) for r in rows
            if r["ranks"] == "1" and r["threads"] != "1"]
     if thr:

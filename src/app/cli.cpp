@@ -58,7 +58,7 @@ int run_cli(int argc, char** argv) {
   run->add_option("--rebalance", run_opt.rebalance,
                   "with mpirun, partition: re-deal the grains when the work imbalance (sum over "
                   "phases of the largest rank's work over the mean) exceeds this, checked every "
-                  "50 steps (0: never; default 1.02)")
+                  "50 steps (0: never; default 1.01)")
       ->check(CLI::NonNegativeNumber);
 
   std::string check_input;

@@ -21,7 +21,7 @@ struct RunOptions {
   std::int64_t stop_after = 0;  ///< if > 0: stop after this many steps of this invocation, as if
                                 ///< interrupted (checkpoint written; for job time limits, tests)
   std::string scheme;      ///< parallel scheme "partition" (default) or "master" (docs/parallel.md)
-  double rebalance = 1.02;  ///< partition: re-deal above this work imbalance (partition.hpp) [-]
+  double rebalance = 1.01;  ///< partition: re-deal above this work imbalance (partition.hpp) [-]
 };
 
 /// Summary of a finished run.
