@@ -11,18 +11,19 @@ namespace mpmcd::app {
 
 namespace {
 
+// Vs = Σ_g Σ_{p in g} V_p (current volumes).
 double grain_area(const mpm::Model<2>& model) {
-  double vs = 0;
-  for (double v : model.points.volume) vs += v;  // Vs = Σ_p V_p (current volumes)
-  return vs;
+  return CompactionObserver::total_area(CompactionObserver::grain_areas(model));
 }
 
-// Vs0 = Σ_p V0_p: the initial grain area, also after a restart (equal bit for bit to Σ_p V_p at
-// t = 0, where V_p = V0_p).
+// Vs0 = Σ_g Σ_{p in g} V0_p: the initial grain area, also after a restart (equal bit for bit to
+// grain_area at t = 0, where V_p = V0_p: the same association).
 double reference_grain_area(const mpm::Model<2>& model) {
-  double vs = 0;
-  for (double v : model.points.volume0) vs += v;
-  return vs;
+  std::vector<double> area(model.grains.size(), 0.0);
+  for (std::size_t g = 0; g < area.size(); ++g)
+    for (std::int64_t p = model.grains[g].begin; p < model.grains[g].end; ++p)
+      area[g] += model.points.volume0[p];
+  return CompactionObserver::total_area(area);
 }
 
 Vec<2> force_on(const mpm::StepStats& step, std::size_t k) {
@@ -103,13 +104,36 @@ std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm
   return out;
 }
 
+std::vector<double> CompactionObserver::grain_areas(const mpm::Model<2>& model,
+                                                    const std::vector<int>* owner, int rank) {
+  std::vector<double> area(model.grains.size(), 0.0);
+  for (std::size_t g = 0; g < area.size(); ++g) {
+    if (owner && (*owner)[g] != rank) continue;
+    for (std::int64_t p = model.grains[g].begin; p < model.grains[g].end; ++p)
+      area[g] += model.points.volume[p];
+  }
+  return area;
+}
+
+double CompactionObserver::total_area(const std::vector<double>& areas) {
+  double vs = 0;
+  for (double a : areas) vs += a;
+  return vs;
+}
+
 std::optional<std::string> CompactionObserver::stop_reason(const mpm::Model<2>& model,
+                                                           const mpm::StepStats& step,
+                                                           double t) const {
+  return stop_reason(grain_area(model), step, t);
+}
+
+std::optional<std::string> CompactionObserver::stop_reason(double grain_area,
                                                            const mpm::StepStats& step,
                                                            double t) const {
   const auto& c = config_.stop;
   if (!box_ || (c.phi <= 0 && c.strain <= 0 && c.stress <= 0)) return std::nullopt;
   const analysis::Box box = analysis::box_at(walls_, *box_, t);
-  const auto s = analysis::compaction_state(box, box0_, grain_area(model), vs0_);
+  const auto s = analysis::compaction_state(box, box0_, grain_area, vs0_);
   if (c.phi > 0 && s.phi >= c.phi)
     return fmt::format("stop.phi reached: Phi = {:.6f} >= {}", s.phi, c.phi);
   if (c.strain > 0 && std::fabs(s.strain) >= c.strain)

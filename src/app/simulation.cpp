@@ -854,8 +854,18 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
       good_since_cut = 0;
       log().info("dt restored to {:.4g} s at t = {:.9g} s", dt, t);
     }
-    if (stop_active && comm.size() > 1) gather_state(-1);       // Phi needs every grain's area
-    const auto criterion = observer.stop_reason(model, st, t);  // [stop] criteria
+    // [stop] criteria. Phi needs every grain's area: on several ranks each one's grains, summed
+    // per grain over the ranks (exact: the other ranks add zeros), then over the grains in
+    // order, as one process does.
+    std::optional<std::string> criterion;
+    if (stop_active && comm.size() > 1) {
+      ScopedStage ts(&solver.timers(), "output");
+      auto areas = CompactionObserver::grain_areas(model, &solver.owner(), comm.rank());
+      comm.sum(areas);
+      criterion = observer.stop_reason(CompactionObserver::total_area(areas), st, t);
+    } else if (stop_active) {
+      criterion = observer.stop_reason(model, st, t);
+    }
     const bool at_end = criterion.has_value() || t >= t_end - 1e-9 * dt_nominal;
     record(at_end);
     if (criterion) {

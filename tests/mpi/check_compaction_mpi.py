@@ -10,9 +10,9 @@ binary, mpiexec, toml, work = sys.argv[1:5]
 RTOL = 1e-6  # relative; the Gauss-Seidel tolerance is 1e-8 and the impulse tolerance 1e-6
 
 
-def run(name, ranks, scheme="partition", extra=()):
+def run(name, ranks, scheme="partition", extra=(), input_file=None):
     out = os.path.join(work, name)
-    cmd = [binary, "run", toml, "-q", "-t", "1", "-o", out, "--scheme", scheme, *extra]
+    cmd = [binary, "run", input_file or toml, "-q", "-t", "1", "-o", out, "--scheme", scheme, *extra]
     if ranks > 1:
         cmd = [mpiexec, "--oversubscribe", "--allow-run-as-root", "-np", str(ranks)] + cmd
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
@@ -60,6 +60,24 @@ for f in sorted(os.listdir(two_a)):
             fail.append(f"2-rank runs differ in {f}")
 if sorted(os.listdir(two_a)) != sorted(os.listdir(serial)):
     fail.append(f"files differ: {sorted(os.listdir(two_a))} vs {sorted(os.listdir(serial))}")
+# [stop] reached mid-run (Phi goes from 0.592 to 0.671): on 2 ranks the grains' areas are summed
+# per grain over the ranks, not gathered; the run must stop after the same step with the same rows.
+src = open(toml).read()
+assert "phi = 0.95" in src and 'file = "packing.csv"' in src
+packing = os.path.join(os.path.dirname(os.path.abspath(toml)), "packing.csv")
+stop_toml = os.path.join(work, "compaction_mpi_stop.toml")
+with open(stop_toml, "w") as f:
+    f.write(src.replace("phi = 0.95", "phi = 0.65").replace('"packing.csv"', f'"{packing}"'))
+stop1 = run("stop_np1", 1, input_file=stop_toml)
+stop2 = run("stop_np2", 2, extra=("--rebalance", "0"), input_file=stop_toml)
+rows1, rows2 = rows(stop1), rows(stop2)
+if not rows1 or float(rows1[-1]["phi"]) < 0.65 or len(rows1) >= len(ref):
+    fail.append(f"[stop] phi = 0.65 not reached mid-run on 1 rank ({len(rows1)} rows)")
+if not filecmp.cmp(os.path.join(stop1, "compaction_mpi.csv"),
+                   os.path.join(stop2, "compaction_mpi.csv"), shallow=False):
+    fail.append("[stop] on 2 ranks: CSV differs from 1 rank")
+else:
+    print(f"[stop] phi = 0.65: both stop at step {rows1[-1]['step']}, Phi = {rows1[-1]['phi']}")
 timers = open(os.path.join(two_a, "compaction_mpi_timers.csv")).read()
 for key in ("p2g", "newton.solve", "contact.solve", "comm.entries", "one_rank_serial_fraction",
             "bytes_sent_per_rank_per_step", "# ranks,2", "# solo_s_at,solver.cpp:"):

@@ -33,6 +33,18 @@ class CompactionObserver {
   /// log), or nullopt.
   std::optional<std::string> stop_reason(const mpm::Model<2>& model, const mpm::StepStats& step,
                                          double t) const;
+  /// The same with the grains' current area V_s [m^2] given (several ranks: the sum over ranks of
+  /// grain_areas, so that no rank needs every point).
+  std::optional<std::string> stop_reason(double grain_area, const mpm::StepStats& step,
+                                         double t) const;
+
+  /// Current area of each grain, sum of its points' V_p [m^2]; with `owner`, only the grains
+  /// with owner[g] == rank (0 for the others).
+  static std::vector<double> grain_areas(const mpm::Model<2>& model,
+                                         const std::vector<int>* owner = nullptr, int rank = 0);
+  /// V_s = sum over grains, in grain order, of grain_areas [m^2]: the association every V_s of a
+  /// run uses, so that per-grain sums gathered from several ranks give the same bits.
+  static double total_area(const std::vector<double>& areas);
 
   /// Replaces V_s0, the grains' area at t = 0 [m^2] (a restarted run must pass the value of the
   /// original start, e.g. from the first CSV row, since the constructor measures the model it is

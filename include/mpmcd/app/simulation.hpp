@@ -20,7 +20,7 @@ struct RunOptions {
   std::string restart;          ///< checkpoint to continue from ("" = start at t = 0)
   std::int64_t stop_after = 0;  ///< if > 0: stop after this many steps of this invocation, as if
                                 ///< interrupted (checkpoint written; for job time limits, tests)
-  std::string scheme;      ///< parallel scheme "partition" (default) or "master" (docs/parallel.md)
+  std::string scheme;  ///< parallel scheme "partition" (default) or "master" (docs/parallel.md)
   double rebalance = 1.01;  ///< partition: re-deal above this work imbalance (partition.hpp) [-]
 };
 
