@@ -2,11 +2,13 @@
 // diameters uniform in [0.8, 1.2] mm, ~8 cells per mean diameter, 2x2 points per cell, four walls,
 // the top one moving down at 2 m/s, dt = 0.1 us): time of contact detection per step, of one
 // Gauss-Seidel sweep per contact, and the share of the step spent in contact, for the grain
-// compliance (LDLT) and the lumped (CG) Delassus operators, 1 and 2 threads.
+// compliance (LDLT) and the lumped (CG) Delassus operators, 1 and 2 threads; and one Gauss-Seidel
+// solve of a synthetic lumped problem on 1 and 2 threads (BM_GaussSeidelNodes).
 //   ./build/release/bench/bench_contact --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include "../tests/support/contact_problems.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "slice_300.hpp"
 
@@ -67,7 +69,27 @@ void BM_ContactPacking(benchmark::State& state) {
   state.counters["contact_share"] = (get("contact.detect") + get("contact.solve")) / total;
 }
 
+// One Gauss-Seidel solve (3 sweeps, 4 error evaluations, copy of the problem included) of a
+// synthetic lumped problem: 1,300 nodes with three grain fields in mutual contact and a wall
+// contact each (5,200 contacts, tests/support/contact_problems.hpp). The nodes are independent
+// problems, swept on the threads.
+void BM_GaussSeidelNodes(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  const auto base = test_support::many_node_problem(1300);
+  for (auto _ : state) {
+    auto p = base;
+    benchmark::DoNotOptimize(contact::solve_gauss_seidel(p, {1e-8, 3}));
+  }
+  state.counters["contacts"] = static_cast<double>(base.contacts.size());
+}
+
 }  // namespace
+
+BENCHMARK(BM_GaussSeidelNodes)
+    ->ArgNames({"threads"})
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ContactPacking)
     ->ArgNames({"solver", "threads"})

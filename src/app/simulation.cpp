@@ -721,6 +721,12 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     std::sort(warm.begin(), warm.end(), [](const auto& x, const auto& y) {
       return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
     });
+    // Right after a re-balancing every rank holds every impulse (set_distribution): keep one.
+    warm.erase(std::unique(warm.begin(), warm.end(),
+                           [](const auto& x, const auto& y) {
+                             return std::tie(x.node, x.a, x.b) == std::tie(y.node, y.a, y.b);
+                           }),
+               warm.end());
     Outputs& out = *out_ptr;
     checkpoint::State s;
     s.dim = 2;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -106,104 +107,136 @@ void free_velocity(const Problem<Dim>& p, const std::vector<Vec<Dim>>& v, const 
 
 }  // namespace
 
+namespace {
+
+// Contacts grouped by the node of their slot B, each group in the serial order, as runs of
+// `order` from start[r] to start[r + 1]. With the lumped operator (no compliance group) a slot
+// belongs to one node and responds to its own impulses only, so contacts of different nodes share
+// nothing: the sweep is a set of independent per-node sweeps (docs/parallel.md). One run holding
+// every contact when groups couple the nodes.
+struct NodeRuns {
+  std::vector<std::int32_t> order, start;
+};
+
+template <int Dim>
+NodeRuns node_runs(const Problem<Dim>& p) {
+  NodeRuns runs;
+  const auto n = static_cast<std::int32_t>(p.contacts.size());
+  runs.order.resize(static_cast<std::size_t>(n));
+  for (std::int32_t c = 0; c < n; ++c) runs.order[c] = c;
+  runs.start.push_back(0);
+  if (!p.groups.empty()) {
+    runs.start.push_back(n);
+    return runs;
+  }
+  const auto node = [&](std::int32_t c) { return p.slots[p.contacts[c].b].node; };
+  std::stable_sort(runs.order.begin(), runs.order.end(),
+                   [&](std::int32_t x, std::int32_t y) { return node(x) < node(y); });
+  for (std::int32_t k = 1; k < n; ++k)
+    if (node(runs.order[k]) != node(runs.order[k - 1])) runs.start.push_back(k);
+  runs.start.push_back(n);
+  return runs;
+}
+
+// Contacts above which the per-node work is shared among threads.
+constexpr std::size_t kThreadedContacts = 1024;
+
+// One sweep: each contact solved exactly with the others' current impulses (method.md §4), in
+// the serial order within a node; the nodes on the threads (the same impulses for any count).
+template <int Dim>
+void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs) {
+  const auto nr = static_cast<std::int64_t>(runs.start.size()) - 1;
+#pragma omp parallel for schedule(dynamic, 64) if (p.contacts.size() > kThreadedContacts)
+  for (std::int64_t r = 0; r < nr; ++r)
+    for (std::int32_t k = runs.start[r]; k < runs.start[r + 1]; ++k) {
+      Contact<Dim>& c = p.contacts[runs.order[k]];
+      Vec<Dim> u;
+      Mat<Dim> W;
+      free_velocity(p, v, c, u, W);
+      const Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
+      const Vec<Dim> dP = P - c.impulse;
+      if (dP == Vec<Dim>::Zero()) continue;
+      respond(p, v, c.b, dP);
+      if (c.a >= 0) respond(p, v, c.a, Vec<Dim>(-dP));
+      c.impulse = P;
+    }
+}
+
+// The sweeps until error() <= tolerance or max_sweeps, error() giving the (global) error.
+template <int Dim, class Error>
+GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& error_now) {
+  GsResult r;
+  r.error = error_now();
+  if (r.error <= settings.tolerance) {
+    r.converged = true;
+    return r;
+  }
+  auto v = slot_velocities(p);
+  const NodeRuns runs = node_runs(p);
+  while (r.sweeps < settings.max_sweeps) {
+    sweep(p, v, runs);
+    ++r.sweeps;
+    r.error = error_now();
+    if (r.error <= settings.tolerance) {
+      r.converged = true;
+      break;
+    }
+  }
+  return r;
+}
+
+// sqrt(num) / sqrt(den), 0 without any change.
+double error_ratio(double num, double den) {
+  return num == 0.0 ? 0.0 : std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
+}
+
+}  // namespace
+
 template <int Dim>
 void error_terms(const Problem<Dim>& p, double& num, double& den) {
   const auto v = slot_velocities(p);
-  num = 0;
-  den = 0;
-  for (const auto& c : p.contacts) {
+  // Each contact's terms on the threads, summed in contact order (the same bits for any count).
+  const auto n = static_cast<std::int64_t>(p.contacts.size());
+  std::vector<double> tn(static_cast<std::size_t>(n)), td(static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(static) if (p.contacts.size() > kThreadedContacts)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const Contact<Dim>& c = p.contacts[i];
     Vec<Dim> u;
     Mat<Dim> W;
     free_velocity(p, v, c, u, W);
     const Vec<Dim> loc = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
-    num += (loc - c.impulse).squaredNorm();
-    den += c.impulse.squaredNorm();
+    tn[i] = (loc - c.impulse).squaredNorm();
+    td[i] = c.impulse.squaredNorm();
+  }
+  num = 0;
+  den = 0;
+  for (std::int64_t i = 0; i < n; ++i) {
+    num += tn[i];
+    den += td[i];
   }
 }
 
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings,
                             const ErrorReduce& reduce) {
-  const auto global_error = [&]() {
+  return gauss_seidel(p, settings, [&]() {
     double num = 0, den = 0;
     error_terms(p, num, den);
     reduce(num, den);
-    return num == 0.0 ? 0.0 : std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
-  };
-  GsResult r;
-  r.error = global_error();
-  if (r.error <= settings.tolerance) {
-    r.converged = true;
-    return r;
-  }
-  auto v = slot_velocities(p);
-  while (r.sweeps < settings.max_sweeps) {
-    for (auto& c : p.contacts) {
-      Vec<Dim> u;
-      Mat<Dim> W;
-      free_velocity(p, v, c, u, W);
-      const Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
-      const Vec<Dim> dP = P - c.impulse;
-      if (dP == Vec<Dim>::Zero()) continue;
-      respond(p, v, c.b, dP);
-      if (c.a >= 0) respond(p, v, c.a, Vec<Dim>(-dP));
-      c.impulse = P;
-    }
-    ++r.sweeps;
-    r.error = global_error();
-    if (r.error <= settings.tolerance) {
-      r.converged = true;
-      break;
-    }
-  }
-  return r;
+    return error_ratio(num, den);
+  });
 }
 
 template <int Dim>
 double error(const Problem<Dim>& p) {
-  const auto v = slot_velocities(p);
   double num = 0, den = 0;
-  for (const auto& c : p.contacts) {
-    Vec<Dim> u;
-    Mat<Dim> W;
-    free_velocity(p, v, c, u, W);
-    const Vec<Dim> loc = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
-    num += (loc - c.impulse).squaredNorm();
-    den += c.impulse.squaredNorm();
-  }
-  if (num == 0.0) return 0.0;
-  return std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
+  error_terms(p, num, den);
+  return error_ratio(num, den);
 }
 
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings) {
-  GsResult r;
-  r.error = error(p);
-  if (p.contacts.empty() || r.error <= settings.tolerance) {
-    r.converged = true;
-    return r;
-  }
-  auto v = slot_velocities(p);
-  while (r.sweeps < settings.max_sweeps) {
-    for (auto& c : p.contacts) {
-      Vec<Dim> u;
-      Mat<Dim> W;
-      free_velocity(p, v, c, u, W);
-      const Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
-      const Vec<Dim> dP = P - c.impulse;
-      if (dP == Vec<Dim>::Zero()) continue;
-      respond(p, v, c.b, dP);
-      if (c.a >= 0) respond(p, v, c.a, Vec<Dim>(-dP));
-      c.impulse = P;
-    }
-    ++r.sweeps;
-    r.error = error(p);
-    if (r.error <= settings.tolerance) {
-      r.converged = true;
-      break;
-    }
-  }
-  return r;
+  return gauss_seidel(p, settings, [&]() { return error(p); });
 }
 
 template <int Dim>

@@ -833,10 +833,16 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
 template <int Dim>
 void ImplicitSolver<Dim>::set_warm_start(std::vector<WarmImpulse<Dim>> impulses) {
   previous_ = std::move(impulses);
-  std::sort(previous_.begin(), previous_.end(),
-            [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
-              return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
-            });
+  const auto key = [](const WarmImpulse<Dim>& x) { return std::tie(x.node, x.a, x.b); };
+  std::stable_sort(
+      previous_.begin(), previous_.end(),
+      [&](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) { return key(x) < key(y); });
+  // One impulse per contact (the union of several ranks' copies holds each once per rank).
+  previous_.erase(std::unique(previous_.begin(), previous_.end(),
+                              [&](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
+                                return key(x) == key(y);
+                              }),
+                  previous_.end());
 }
 
 template <int Dim>
@@ -1277,6 +1283,30 @@ void ImplicitSolver<Dim>::set_distribution(const parallel::Comm* comm, std::vect
                      "the grain compliance operator couples all contacts of a grain and is not "
                      "available on more than one rank yet: use delassus = \"lumped\" (or run on "
                      "one rank)");
+  if (!distributed()) return;
+  // Every rank's warm-start impulses to every rank: the contacts of a node move with its lowest
+  // grain, and the new owner must find their impulses (as after a restart, which reads them all).
+  parallel::Buffer mine;
+  for (const auto& w : previous_) {
+    mine.put(w.node);
+    mine.put(w.a);
+    mine.put(w.b);
+    for (int d = 0; d < Dim; ++d) mine.put(w.impulse[d]);
+  }
+  std::vector<WarmImpulse<Dim>> all;
+  for (const auto& bytes : comm_->allgather(mine.bytes())) {
+    parallel::Buffer b;
+    b.bytes() = bytes;
+    while (!b.done()) {
+      WarmImpulse<Dim> w;
+      w.node = b.get<std::int64_t>();
+      w.a = b.get<std::int32_t>();
+      w.b = b.get<std::int32_t>();
+      for (int d = 0; d < Dim; ++d) w.impulse[d] = b.get<double>();
+      all.push_back(w);
+    }
+  }
+  set_warm_start(std::move(all));
 }
 
 template <int Dim>

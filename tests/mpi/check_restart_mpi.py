@@ -4,7 +4,8 @@
 1. A 2-rank run that re-deals its grains at every 50-step check, stopped with --stop-after at a
    step that is not a multiple of 50 and restarted on 2 ranks, ends bitwise identical to the
    uninterrupted run: every CSV, VTU and PVD file and the final checkpoint's bytes (so the
-   distribution, the re-balancing counts and every rank's warm-start impulses were saved).
+   distribution, the re-balancing counts and every rank's warm-start impulses were saved). The
+   same stopped at step 200, in the step of a re-balancing that moves grains.
 2. The same checkpoint restarted on 1 rank gives the observables of the 2-rank run within the
    contact tolerance.
 3. SIGTERM to mpirun mid-run: every rank stops after the same step, one checkpoint is written,
@@ -64,6 +65,15 @@ for f in sorted(os.listdir(full)):
         elif not filecmp.cmp(os.path.join(full, f), other, shallow=False):
             fail.append(f"restarted 2-rank run differs in {f}")
 print(f"2 ranks, stopped at step 130 and restarted: {compared} files compared")
+
+# 1b. Stopped at step 200, in the step of a re-balancing that moves grains (their nodes'
+# contacts change rank; every rank then holds every warm-start impulse): bitwise too.
+part200 = os.path.join(work, "part200")
+run([toml, "-o", part200, "--stop-after", "200", *REBALANCE], 2, expect=4)
+run(["--restart", os.path.join(part200, "compaction_mpi_checkpoint_000000200.h5"), *REBALANCE], 2)
+for f in ("compaction_mpi.csv", "compaction_mpi_checkpoint_000000320.h5"):
+    if not filecmp.cmp(os.path.join(full, f), os.path.join(part200, f), shallow=False):
+        fail.append(f"restarted at a re-balancing step: {f} differs")
 
 # 2. The 2-rank checkpoint on 1 rank.
 run(["--restart", os.path.join(single, os.path.basename(ckpt))], 1)

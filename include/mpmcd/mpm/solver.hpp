@@ -144,6 +144,8 @@ class ImplicitSolver {
   /// owner[g] == comm.rank() (their points must be current here; others' may be stale); contacts
   /// at a node are solved by the rank owning the node's lowest grain (kPartition) or by rank 0
   /// (kMaster). Needs the lumped Delassus operator when comm has more than one rank.
+  /// Collective on several ranks: every rank then holds every rank's warm-start impulses, so
+  /// that a node whose contacts change rank keeps its impulses (re-balancing).
   void set_distribution(const parallel::Comm* comm, std::vector<int> owner,
                         parallel::Scheme scheme);
   /// Rank computing each grain (all 0 when serial).

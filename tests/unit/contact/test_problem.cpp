@@ -1,10 +1,12 @@
 // The local Signorini-Coulomb solution, the Gauss-Seidel solver and the problem file round trip.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <filesystem>
 #include <fstream>
 #include <random>
 
+#include "../../support/contact_problems.hpp"
 #include "mpmcd/contact/problem.hpp"
 #include "mpmcd/core/errors.hpp"
 
@@ -80,6 +82,50 @@ TEST(GaussSeidel, StackOnWallConvergesToNoPenetration) {
     }
     EXPECT_EQ(contact::error(p), r.error);
   }
+}
+
+TEST(GaussSeidel, NodesSweptOnThreadsGiveTheSameImpulsesBitForBit) {
+  // 4,000 contacts (above the threading threshold) at 1,000 independent nodes: with the lumped
+  // operator each node's contacts are swept in their serial order, the nodes on the threads; the
+  // error is summed in contact order. 1 and 2 threads: the same sweeps, error and impulses.
+  const int saved = omp_get_max_threads();
+  std::vector<contact::Problem<2>> solved;
+  std::vector<contact::GsResult> results;
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    auto p = test_support::many_node_problem(1000);
+    results.push_back(contact::solve_gauss_seidel(p, {1e-10, 10000}));
+    solved.push_back(std::move(p));
+  }
+  omp_set_num_threads(saved);
+  ASSERT_TRUE(results[0].converged) << results[0].sweeps << " " << results[0].error;
+  EXPECT_GT(results[0].sweeps, 2);
+  EXPECT_EQ(results[0].sweeps, results[1].sweeps);
+  EXPECT_EQ(results[0].error, results[1].error);
+  int active = 0;
+  for (std::size_t c = 0; c < solved[0].contacts.size(); ++c) {
+    EXPECT_EQ(solved[0].contacts[c].impulse, solved[1].contacts[c].impulse) << "contact " << c;
+    active += solved[0].contacts[c].impulse.squaredNorm() > 0;
+  }
+  EXPECT_GT(active, 1000);  // the sweeps did work at many nodes
+  // A node alone gives its contacts the same impulses: the nodes are independent problems.
+  auto one = test_support::many_node_problem(1000);
+  contact::Problem<2> node5;
+  node5.dt = one.dt;
+  for (int k = 0; k < 3; ++k) node5.slots.push_back(one.slots[15 + k]);
+  for (int c : {15, 16, 17, 3005}) {
+    auto ct = one.contacts[c];
+    ct.a = ct.a < 0 ? -1 : ct.a - 15;
+    ct.b -= 15;
+    node5.contacts.push_back(ct);
+  }
+  const auto r5 = contact::solve_gauss_seidel(node5, {1e-14, 10000});
+  ASSERT_TRUE(r5.converged);
+  int k = 0;
+  for (int c : {15, 16, 17, 3005})
+    EXPECT_NEAR((node5.contacts[k++].impulse - solved[0].contacts[c].impulse).norm(), 0.0,
+                1e-6 * solved[0].contacts[c].impulse.norm() + 1e-300)
+        << "contact " << c;
 }
 
 TEST(GaussSeidel, ReplayedProblemGivesTheSameImpulses) {
