@@ -615,17 +615,20 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   tangent_.resize(np);
   history_trial_ = points_.history;
   const bool linear = settings_.shape == grid::ShapeKind::kLinear;
-  auto collect_failure = [&]() {
-    bool failed = false;
+  // This rank's lowest failing grain into stats; true if there is one.
+  auto local_failure = [&]() {
     for (std::size_t g : owned_)
       if (!work_[g]->failure.empty()) {
         stats.failure = work_[g]->failure;
         stats.grain = static_cast<std::int64_t>(g);
         stats.point = work_[g]->fail_point;
         stats.retryable = work_[g]->retryable;
-        failed = true;
-        break;
+        return true;
       }
+    return false;
+  };
+  auto collect_failure = [&]() {
+    const bool failed = local_failure();
     return dist ? sync_failure(stats) : failed;
   };
   {
@@ -691,7 +694,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       }
       if (dist) comm_->count_work(units);
     }
-    if (collect_failure()) return stats;
+    const bool failed_here = local_failure();
     // Convergence of each evaluated grain: |R| <= tol * reference and |dv|_M <= tol * velocity
     // scale, the references floored at 1e-3 of the largest grain's so that a grain at rest (whose
     // own scales vanish) is judged on the scale of the step, not on round-off.
@@ -700,12 +703,19 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       ref_scale = std::max(ref_scale, work_[g]->res_ref);
       vel_scale = std::max(vel_scale, work_[g]->vel_ref);
     }
-    if (dist) {  // max is exact: the same scales as one process
+    if (dist) {
+      // One reduction for the scales (max is exact: the same scales as one process) and the
+      // failures: the lowest failing grain over the ranks, as the largest of its negatives.
+      constexpr double kNoGrain = 1e300;
       ScopedStage tc(&timers_, "newton.check.comm");
-      std::vector<double> sc{ref_scale, vel_scale};
+      std::vector<double> sc{ref_scale, vel_scale,
+                             failed_here ? -static_cast<double>(stats.grain) : -kNoGrain};
       comm_->max(sc);
       ref_scale = sc[0];
       vel_scale = sc[1];
+      if (sc[2] > -kNoGrain && sync_failure(stats, static_cast<std::int64_t>(-sc[2]))) return stats;
+    } else if (failed_here) {
+      return stats;
     }
     double worst = 0;
     bool all = true;
@@ -1324,12 +1334,16 @@ double& ImplicitSolver<Dim>::phase_work(std::size_t g, int iteration) {
 }
 
 template <int Dim>
-bool ImplicitSolver<Dim>::sync_failure(StepStats& stats) {
-  // The lowest failing grain over all ranks, its message from its owner.
+bool ImplicitSolver<Dim>::sync_failure(StepStats& stats, std::int64_t lowest) {
+  // The lowest failing grain over all ranks (reduced here unless given), its message from its
+  // owner.
   ScopedStage tc(&timers_, "newton.check.comm");
   constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
-  std::vector<std::int64_t> g{stats.failure.empty() ? kNone : stats.grain};
-  comm_->min(g);
+  std::vector<std::int64_t> g{lowest};
+  if (lowest < 0) {
+    g[0] = stats.failure.empty() ? kNone : stats.grain;
+    comm_->min(g);
+  }
   if (g[0] == kNone) return false;
   const int root = owner_[static_cast<std::size_t>(g[0])];
   parallel::Buffer b;

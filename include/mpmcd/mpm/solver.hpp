@@ -199,7 +199,9 @@ class ImplicitSolver {
   void detect_contacts(double dt);
   double update_contacts(StepStats& stats);
   std::int32_t slot_of(std::int32_t g, std::int32_t a);
-  bool sync_failure(StepStats& stats);
+  // Agrees on the lowest failing grain over the ranks (reduced here when `lowest` < 0, else that
+  // grain) and gives every rank its owner's failure message; false when no rank failed.
+  bool sync_failure(StepStats& stats, std::int64_t lowest = -1);
   void exchange_entries();
   void exchange_requests();
   double update_contacts_distributed(StepStats& stats);
