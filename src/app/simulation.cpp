@@ -690,43 +690,12 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     ScopedStage ts(&solver.timers(), "checkpoint");
     if (comm.size() > 1) gather_state(0);
     // Warm-start impulses of every rank (each contact is solved by one rank).
-    parallel::Buffer mine;
-    for (const auto& w : solver.warm_start()) {
-      mine.put(w.node);
-      mine.put(w.a);
-      mine.put(w.b);
-      mine.put(w.impulse[0]);
-      mine.put(w.impulse[1]);
-    }
-    const auto all = comm.allgather(mine.bytes());
+    const auto warm = solver.gather_warm_start();
     std::vector<double> work = solver.grain_work();
     work.resize(model.grains.size() * parallel::kWorkPhases, 0.0);
     comm.sum(work);
     last_checkpoint_step = summary.steps;
     if (!root) return std::string();
-    std::vector<mpm::WarmImpulse<2>> warm;
-    for (const auto& bytes : all) {
-      parallel::Buffer b;
-      b.bytes() = bytes;
-      while (!b.done()) {
-        mpm::WarmImpulse<2> w;
-        w.node = b.get<std::int64_t>();
-        w.a = b.get<std::int32_t>();
-        w.b = b.get<std::int32_t>();
-        w.impulse[0] = b.get<double>();
-        w.impulse[1] = b.get<double>();
-        warm.push_back(w);
-      }
-    }
-    std::sort(warm.begin(), warm.end(), [](const auto& x, const auto& y) {
-      return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
-    });
-    // Right after a re-balancing every rank holds every impulse (set_distribution): keep one.
-    warm.erase(std::unique(warm.begin(), warm.end(),
-                           [](const auto& x, const auto& y) {
-                             return std::tie(x.node, x.a, x.b) == std::tie(y.node, y.a, y.b);
-                           }),
-               warm.end());
     Outputs& out = *out_ptr;
     checkpoint::State s;
     s.dim = 2;

@@ -843,16 +843,21 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
 template <int Dim>
 void ImplicitSolver<Dim>::set_warm_start(std::vector<WarmImpulse<Dim>> impulses) {
   previous_ = std::move(impulses);
+  sort_unique(previous_);
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::sort_unique(std::vector<WarmImpulse<Dim>>& impulses) {
   const auto key = [](const WarmImpulse<Dim>& x) { return std::tie(x.node, x.a, x.b); };
   std::stable_sort(
-      previous_.begin(), previous_.end(),
+      impulses.begin(), impulses.end(),
       [&](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) { return key(x) < key(y); });
   // One impulse per contact (the union of several ranks' copies holds each once per rank).
-  previous_.erase(std::unique(previous_.begin(), previous_.end(),
-                              [&](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
-                                return key(x) == key(y);
-                              }),
-                  previous_.end());
+  impulses.erase(std::unique(impulses.begin(), impulses.end(),
+                             [&](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
+                               return key(x) == key(y);
+                             }),
+                 impulses.end());
 }
 
 template <int Dim>
@@ -1293,9 +1298,14 @@ void ImplicitSolver<Dim>::set_distribution(const parallel::Comm* comm, std::vect
                      "the grain compliance operator couples all contacts of a grain and is not "
                      "available on more than one rank yet: use delassus = \"lumped\" (or run on "
                      "one rank)");
-  if (!distributed()) return;
   // Every rank's warm-start impulses to every rank: the contacts of a node move with its lowest
   // grain, and the new owner must find their impulses (as after a restart, which reads them all).
+  if (distributed()) set_warm_start(gather_warm_start());
+}
+
+template <int Dim>
+std::vector<WarmImpulse<Dim>> ImplicitSolver<Dim>::gather_warm_start() const {
+  if (!distributed()) return previous_;
   parallel::Buffer mine;
   for (const auto& w : previous_) {
     mine.put(w.node);
@@ -1316,7 +1326,8 @@ void ImplicitSolver<Dim>::set_distribution(const parallel::Comm* comm, std::vect
       all.push_back(w);
     }
   }
-  set_warm_start(std::move(all));
+  sort_unique(all);
+  return all;
 }
 
 template <int Dim>

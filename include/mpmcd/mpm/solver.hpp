@@ -168,6 +168,9 @@ class ImplicitSolver {
   const std::vector<WarmImpulse<Dim>>& warm_start() const { return previous_; }
   /// Replaces the warm-start impulses (a restart); sorts them by (node, a, b).
   void set_warm_start(std::vector<WarmImpulse<Dim>> impulses);
+  /// Every rank's warm-start impulses, sorted by (node, a, b), one per contact (collective on
+  /// several ranks; this rank's own when serial): checkpoints and re-distribution.
+  std::vector<WarmImpulse<Dim>> gather_warm_start() const;
   /// Attempts the step t -> t + dt [s] from the committed point state; changes no point data.
   StepStats solve_step(double dt);
   /// Commits the last converged step: G2P positions and velocities, F, stress, volume, history.
@@ -202,6 +205,8 @@ class ImplicitSolver {
   // Agrees on the lowest failing grain over the ranks (reduced here when `lowest` < 0, else that
   // grain) and gives every rank its owner's failure message; false when no rank failed.
   bool sync_failure(StepStats& stats, std::int64_t lowest = -1);
+  // Sorts warm-start impulses by (node, a, b) and keeps one per contact.
+  static void sort_unique(std::vector<WarmImpulse<Dim>>& impulses);
   void exchange_entries();
   void exchange_requests();
   double update_contacts_distributed(StepStats& stats);
