@@ -10,6 +10,8 @@
 // `--mirror 1` measures the machine's noise floor for the serial fraction: every rank computes
 // the whole slice alone (identical work) and the ranks synchronise once per step, so the time one
 // rank works alone is only the run-to-run jitter of identical work.
+// `--trace FILE` writes every synchronisation of the timed steps (code line, each rank's work
+// interval in wall and CPU time, counted units) for tools/serial_ensemble.py.
 #include <fmt/format.h>
 #include <omp.h>
 
@@ -28,7 +30,7 @@
 using namespace mpmcd;
 
 int main(int argc, char** argv) {
-  std::string scheme_name = "partition", csv;
+  std::string scheme_name = "partition", csv, trace;
   int threads = 1, warmup = 50, steps = 50, cpu = 0, every = 25, mirror = 0;
   double threshold = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -51,6 +53,8 @@ int main(int argc, char** argv) {
       every = std::stoi(v);
     else if (k == "--mirror")
       mirror = std::stoi(v);
+    else if (k == "--trace")
+      trace = v;
     else {
       std::cerr << "unknown option " << k << "\n";
       return 2;
@@ -82,6 +86,7 @@ int main(int argc, char** argv) {
     if (step == warmup) {
       comm.barrier();
       solver.timers().clear();
+      if (!trace.empty()) comm.trace_syncs(trace);
       comm.record_syncs();
       bytes0 = comm.bytes_sent();
       t0 = std::chrono::steady_clock::now();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <ctime>
 #include <stdexcept>
 
@@ -31,6 +32,12 @@ double cpu_s() {
 // Global collectives between two folds of the recorded intervals (bounds the buffer: about 40
 // synchronisations per time step, 12 bytes each).
 constexpr std::int64_t kFoldEvery = 1 << 16;
+
+// "file.cpp:line" of a synchronisation (the file name without its directories).
+std::string site_name(const char* path, std::int32_t line) {
+  const std::string file = path;
+  return fmt::format("{}:{}", file.substr(file.find_last_of('/') + 1), line);
+}
 }  // namespace
 
 // Brackets one synchronisation: arrival on construction, departure on destruction; global
@@ -58,6 +65,7 @@ void Comm::record_syncs() const {
   line_.clear();
   file_.clear();
   collectives_ = 0;
+  traced_ = 0;
   folded_ = SoloReport{};
   last_exit_ = now_s();
   last_exit_cpu_ = cpu_s();
@@ -108,13 +116,12 @@ void Comm::fold_syncs() const {
       }
       return first - second;
     };
+    if (root && !trace_path_.empty()) write_trace(all_w, all_c, all_u, n);
     for (std::int64_t k = 0; root && k < n; ++k) {
       const auto ks = static_cast<std::size_t>(k);
       for (int r = 0; r < size_; ++r)
         if (all_l[static_cast<std::size_t>(r * n + k)] != line_[ks]) folded_.consistent = false;
-      const std::string file = file_[ks];
-      const std::string site =
-          fmt::format("{}:{}", file.substr(file.find_last_of('/') + 1), line_[ks]);
+      const std::string site = site_name(file_[ks], line_[ks]);
       const double s = solo(all_w, k);
       folded_.solo_s += s;
       folded_.solo_cpu_s += solo(all_c, k);
@@ -131,6 +138,34 @@ void Comm::fold_syncs() const {
   units_.clear();
   line_.clear();
   file_.clear();
+}
+
+void Comm::trace_syncs(const std::string& path) const {
+  trace_path_ = path;
+}
+
+void Comm::write_trace(const std::vector<double>& all_w, const std::vector<double>& all_c,
+                       const std::vector<double>& all_u, std::int64_t n) const {
+  const bool fresh = traced_ == 0;
+  std::FILE* f = std::fopen(trace_path_.c_str(), fresh ? "w" : "a");
+  if (f == nullptr)
+    throw std::runtime_error(fmt::format("cannot write the synchronisation trace {}", trace_path_));
+  if (fresh) {
+    std::string head = "sync,site";
+    for (const char* col : {"wall_s", "cpu_s", "units"})
+      for (int r = 0; r < size_; ++r) head += fmt::format(",{}{}", col, r);
+    std::fprintf(f, "%s\n", head.c_str());
+  }
+  for (std::int64_t k = 0; k < n; ++k) {
+    const auto ks = static_cast<std::size_t>(k);
+    std::string row = fmt::format("{},{}", traced_ + k, site_name(file_[ks], line_[ks]));
+    for (const auto* all : {&all_w, &all_c, &all_u})
+      for (int r = 0; r < size_; ++r)
+        row += fmt::format(",{:.9g}", (*all)[static_cast<std::size_t>(r * n + k)]);
+    std::fprintf(f, "%s\n", row.c_str());
+  }
+  std::fclose(f);
+  traced_ += n;
 }
 
 Comm::SoloReport Comm::solo_report() const {

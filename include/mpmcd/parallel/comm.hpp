@@ -119,6 +119,12 @@ class Comm {
   };
   /// The report since record_syncs (collective; complete on rank 0, totals on every rank).
   SoloReport solo_report() const;
+  /// Also writes every recorded synchronisation to the CSV file `path` (rank 0; every rank must
+  /// call it, before record_syncs): one row per synchronisation with its code line and each
+  /// rank's wall-time work interval [s], CPU-time interval [s] and counted units [-]. Runs that
+  /// are bitwise identical make the same rows except for the times, so tools/serial_ensemble.py
+  /// averages each synchronisation's intervals over repeated runs (docs/parallel.md).
+  void trace_syncs(const std::string& path) const;
 
  private:
   Comm();
@@ -129,6 +135,9 @@ class Comm {
   void depart() const;
   // Folds the recorded intervals into the totals (collective; every rank at the same call).
   void fold_syncs() const;
+  // Appends the gathered intervals (rank-major, n per rank) to the trace_syncs file (rank 0).
+  void write_trace(const std::vector<double>& all_w, const std::vector<double>& all_c,
+                   const std::vector<double>& all_u, std::int64_t n) const;
   int rank_ = 0, size_ = 1;
   mutable std::int64_t bytes_sent_ = 0, messages_sent_ = 0;
   mutable bool recording_ = false;
@@ -144,6 +153,8 @@ class Comm {
   mutable std::vector<const char*> file_;   // source file of each sync
   mutable std::int64_t collectives_ = 0;    // global collectives since record_syncs
   mutable SoloReport folded_;               // totals of the intervals already folded
+  mutable std::string trace_path_;          // trace_syncs file ("" = none)
+  mutable std::int64_t traced_ = 0;         // synchronisations written to it
 };
 
 }  // namespace mpmcd::parallel
