@@ -1433,6 +1433,10 @@ void ImplicitSolver<Dim>::exchange_entries() {
   for (int r : neighbours_) out[r];
   std::vector<std::int32_t> sel, pts;
   std::vector<char> dest(static_cast<std::size_t>(np));
+  // Counted work (Comm::count_work): grain pairs tested above; node-in-box and wall tests, values
+  // packed.
+  comm_->count_work(kPairTestWeight * static_cast<double>(owned_.size() * ng));
+  double tests = 0, items = 0;
   for (std::size_t g : owned_) {
     const GrainWork& w = *work_[g];
     if (master && me == 0) break;
@@ -1442,13 +1446,16 @@ void ImplicitSolver<Dim>::exchange_entries() {
         if (w.m[a] < w.contact_mass) continue;
         const IVec<Dim> c = w.node_box[a] + w.box_lo;
         bool send = false;
-        for (std::size_t g2 : near[g])
+        for (std::size_t g2 : near[g]) {
+          tests += 1;
           if ((master || owner_[g2] == r) && inside(g2, c)) {
             send = true;
             break;
           }
+        }
         if (!send && master) {
           const Vec<Dim> xn = grid_.node_position(c);
+          tests += static_cast<double>(cs.walls.size());
           for (const auto& wall : cs.walls)
             if (wall.distance(xn, time_) <= cs.wall_range * h) send = true;
         }
@@ -1479,8 +1486,10 @@ void ImplicitSolver<Dim>::exchange_entries() {
         b.put(points_.x[p]);
         b.put(points_.F[p]);
       }
+      items += static_cast<double>(sel.size() + 2 * pts.size());
     }
   }
+  comm_->count_work(kBoxTestWeight * tests + kExchangeItemWeight * items);
   auto in = comm_->exchange(out, neighbours_);
   // 4. Ghost grains: their sent nodes as a field of this rank (mass, mass gradient, points).
   for (auto& [r, b] : in) {
@@ -1512,6 +1521,7 @@ void ImplicitSolver<Dim>::exchange_entries() {
       w.v.assign(k, Vec<Dim>::Zero());
       w.P.assign(k, Vec<Dim>::Zero());
       w.mask.assign(k, 0);
+      comm_->count_work(kExchangeItemWeight * static_cast<double>(k + w.node_pts.size() + npts));
     }
   }
   local_.clear();
@@ -1532,6 +1542,7 @@ void ImplicitSolver<Dim>::exchange_requests() {
     links_[r];
     out[r];
   }
+  comm_->count_work(kExchangeItemWeight * static_cast<double>(slot_ref_.size()));
   for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
     const auto [g, a] = slot_ref_[s];
     if (role_[g] != 2) continue;
@@ -1561,10 +1572,25 @@ void ImplicitSolver<Dim>::exchange_requests() {
       link.serve.emplace_back(g, a);
     }
   }
+  comm_->count_work(kExchangeItemWeight * static_cast<double>(link_sizes().first));
+}
+
+template <int Dim>
+std::pair<std::size_t, std::size_t> ImplicitSolver<Dim>::link_sizes() const {
+  std::size_t serve = 0, ask = 0;
+  for (const auto& [r, link] : links_) {
+    serve += link.serve.size();
+    ask += link.ask.size();
+  }
+  return {serve, ask};
 }
 
 template <int Dim>
 double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
+  // Counted work (Comm::count_work) of the bookkeeping around the solve: slots served to and
+  // asked from other ranks, this rank's slots, one pass over its contacts after the solve.
+  const auto [n_serve, n_ask] = link_sizes();
+  const auto n_slots = static_cast<double>(problem_.slots.size());
   // 1. Velocities of the ghost slots from their owners (boundary data, neighbours only).
   {
     ScopedStage tc(&timers_, "contact.solve.comm");
@@ -1573,6 +1599,7 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
       parallel::Buffer& b = out[r];
       for (const auto& [g, a] : link.serve) b.put(work_[g]->v[a]);
     }
+    comm_->count_work(kExchangeItemWeight * static_cast<double>(n_serve));
     auto in = comm_->exchange(out, neighbours_);
     for (const auto& [r, link] : links_) {
       parallel::Buffer& b = in.at(r);
@@ -1592,6 +1619,7 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
   }
   std::vector<Vec<Dim>> old(problem_.contacts.size());
   for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
+  comm_->count_work(kExchangeItemWeight * (static_cast<double>(n_ask) + n_slots));
   // 3. Gauss-Seidel: each rank on its nodes' contacts (no slot is shared between ranks), the
   // error summed over ranks before every test (partition); all contacts on rank 0 (master).
   contact::GsResult r;
@@ -1662,11 +1690,13 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
         work_[slot_ref_[s].first]->P[slot_ref_[s].second] = slot_p[s];
       }
     }
+    comm_->count_work(kExchangeItemWeight * (static_cast<double>(old.size() + n_ask) + n_slots));
     auto in = comm_->exchange(out, neighbours_);
     for (const auto& [rk, link] : links_) {
       parallel::Buffer& b = in.at(rk);
       for (const auto& [g, a] : link.serve) apply(g, a, take<Vec<Dim>>(b));
     }
+    comm_->count_work(kExchangeItemWeight * static_cast<double>(n_serve));
     std::vector<double> v{num, den};
     comm_->sum(v);
     num = v[0];
