@@ -133,7 +133,9 @@ int main(int argc, char** argv) {
   // largest over ranks is the step time of a machine where no rank waits for a core.
   double work = 0;
   for (const auto& [name, t] : solver.timers().totals()) {
-    if (name.ends_with(".comm") || name.starts_with("comm.") || name == "contact.gs") continue;
+    if (name.ends_with(".comm") || name.starts_with("comm.") || name == "contact.gs" ||
+        name == kThreadedStage)
+      continue;
     const auto it = solver.timers().totals().find(name + ".comm");
     work += t - (it == solver.timers().totals().end() ? 0.0 : it->second);
   }
@@ -146,11 +148,11 @@ int main(int argc, char** argv) {
     // One row: configuration, step time, serial shares (measured at every synchronisation, and
     // the stage-total imbalance that bounds it from below), time per step in which one rank
     // works alone, traffic, then per stage (ms per step): mean time and stage-total imbalance.
-    double imbalance = 0, one = 0;
+    double imbalance = 0;
+    const double one = parallel::one_thread_fraction(rows, wall, threads, solo);
     std::string stages;
     for (const auto& r : rows) {
       if (!r.nested) imbalance += r.serial;
-      if (!r.nested && r.one_thread && threads > 1) one += r.mean;
       stages +=
           fmt::format(",{}={:.4f}/{:.4f}", r.name, 1e3 * r.mean / steps, 1e3 * r.serial / steps);
     }
@@ -160,7 +162,7 @@ int main(int argc, char** argv) {
         mirror != 0 ? "mirror" : scheme_name, comm.size(), threads, model.points.size(), steps,
         1e3 * wall / steps, 1e3 * work_max[0] / steps, solo.solo_s / wall, imbalance / wall,
         1e3 * solo.solo_s / steps, 1e3 * solo.solo_cpu_s / steps, solo.solo_work_fraction,
-        solo.wait_s / wall, one / wall, bytes[0] / comm.size() / steps, bytes_max[0] / steps,
+        solo.wait_s / wall, one, bytes[0] / comm.size() / steps, bytes_max[0] / steps,
         bytes[1] / comm.size() / steps, contacts / steps, sweeps / steps, iters / steps, stages);
     std::cout << report << line;
     if (!csv.empty()) {

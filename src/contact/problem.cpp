@@ -144,8 +144,9 @@ constexpr std::size_t kThreadedContacts = 1024;
 // One sweep: each contact solved exactly with the others' current impulses (method.md §4), in
 // the serial order within a node; the nodes on the threads (the same impulses for any count).
 template <int Dim>
-void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs) {
+void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, StageTimers* timers) {
   const auto nr = static_cast<std::int64_t>(runs.start.size()) - 1;
+  const ThreadedRegion threaded(timers, p.contacts.size() > kThreadedContacts);
 #pragma omp parallel for schedule(dynamic, 64) if (p.contacts.size() > kThreadedContacts)
   for (std::int64_t r = 0; r < nr; ++r)
     for (std::int32_t k = runs.start[r]; k < runs.start[r + 1]; ++k) {
@@ -174,7 +175,7 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& 
   auto v = slot_velocities(p);
   const NodeRuns runs = node_runs(p);
   while (r.sweeps < settings.max_sweeps) {
-    sweep(p, v, runs);
+    sweep(p, v, runs, settings.timers);
     ++r.sweeps;
     r.error = error_now();
     if (r.error <= settings.tolerance) {
@@ -193,20 +194,23 @@ double error_ratio(double num, double den) {
 }  // namespace
 
 template <int Dim>
-void error_terms(const Problem<Dim>& p, double& num, double& den) {
+void error_terms(const Problem<Dim>& p, double& num, double& den, StageTimers* timers) {
   const auto v = slot_velocities(p);
   // Each contact's terms on the threads, summed in contact order (the same bits for any count).
   const auto n = static_cast<std::int64_t>(p.contacts.size());
   std::vector<double> tn(static_cast<std::size_t>(n)), td(static_cast<std::size_t>(n));
+  {
+    const ThreadedRegion threaded(timers, p.contacts.size() > kThreadedContacts);
 #pragma omp parallel for schedule(static) if (p.contacts.size() > kThreadedContacts)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const Contact<Dim>& c = p.contacts[i];
-    Vec<Dim> u;
-    Mat<Dim> W;
-    free_velocity(p, v, c, u, W);
-    const Vec<Dim> loc = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
-    tn[i] = (loc - c.impulse).squaredNorm();
-    td[i] = c.impulse.squaredNorm();
+    for (std::int64_t i = 0; i < n; ++i) {
+      const Contact<Dim>& c = p.contacts[i];
+      Vec<Dim> u;
+      Mat<Dim> W;
+      free_velocity(p, v, c, u, W);
+      const Vec<Dim> loc = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
+      tn[i] = (loc - c.impulse).squaredNorm();
+      td[i] = c.impulse.squaredNorm();
+    }
   }
   num = 0;
   den = 0;
@@ -221,7 +225,7 @@ GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings,
                             const ErrorReduce& reduce) {
   return gauss_seidel(p, settings, [&]() {
     double num = 0, den = 0;
-    error_terms(p, num, den);
+    error_terms(p, num, den, settings.timers);
     reduce(num, den);
     return error_ratio(num, den);
   });
@@ -236,7 +240,11 @@ double error(const Problem<Dim>& p) {
 
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings) {
-  return gauss_seidel(p, settings, [&]() { return error(p); });
+  return gauss_seidel(p, settings, [&]() {
+    double num = 0, den = 0;
+    error_terms(p, num, den, settings.timers);
+    return error_ratio(num, den);
+  });
 }
 
 template <int Dim>
@@ -373,7 +381,7 @@ Problem<Dim> read_problem(const std::string& path) {
   template Vec<D> local_solution<D>(const Vec<D>&, const Mat<D>&, const Vec<D>&, double, double); \
   template double error<D>(const Problem<D>&);                                                    \
   template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&);                        \
-  template void error_terms<D>(const Problem<D>&, double&, double&);                              \
+  template void error_terms<D>(const Problem<D>&, double&, double&, StageTimers*);                \
   template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&, const ErrorReduce&);    \
   template void write_problem<D>(const Problem<D>&, const std::string&);                          \
   template Problem<D> read_problem<D>(const std::string&);

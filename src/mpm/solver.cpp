@@ -633,6 +633,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   };
   {
     ScopedStage t(&timers_, "p2g");
+    const ThreadedRegion threaded(&timers_, no > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (no > 1)
     for (std::size_t i = 0; i < no; ++i) {
       const std::size_t g = owned_[i];
@@ -678,6 +679,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     {
       ScopedStage t(&timers_, "newton.assemble");
       double units = 0;
+      const ThreadedRegion threaded(&timers_, no > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (no > 1) reduction(+ : units)
       for (std::size_t i = 0; i < no; ++i) {
         const std::size_t g = owned_[i];
@@ -754,6 +756,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     {
       ScopedStage t(&timers_, "newton.solve");
       double units = 0;
+      const ThreadedRegion threaded(&timers_, no > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (no > 1) reduction(+ : units)
       for (std::size_t i = 0; i < no; ++i) {
         const std::size_t g = owned_[i];
@@ -953,6 +956,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   const auto nshared = static_cast<std::int64_t>(shared.size());
   // Work count (Comm::count_work): node fields, pairs and point pairs of the gaps examined here.
   double items = static_cast<double>(entries.size());
+  ThreadedRegion threaded(&timers_, nshared > 256);
 #pragma omp parallel for schedule(dynamic, 32) if (nshared > 256) reduction(+ : items)
   for (std::int64_t i = 0; i < nshared; ++i) {
     const std::int64_t n = shared[i];
@@ -997,6 +1001,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         found[i].push_back({A, B, normal, gap});
       }
   }
+  threaded.done();
   for (std::size_t i = 0; i < shared.size(); ++i)
     for (const Candidate& f : found[i]) {
       contact::Contact<Dim> c;
@@ -1127,9 +1132,11 @@ template <int Dim>
 double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   // Response of each grain: its compliance group (exact, linearised) or the lumped 1/m_I.
   const auto ngroups = static_cast<std::int64_t>(problem_.groups.size());
+  ThreadedRegion threaded(&timers_, ngroups > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1)
   for (std::int64_t gi = 0; gi < ngroups; ++gi)
     grain_compliance(static_cast<std::size_t>(slot_ref_[problem_.groups[gi].slots[0]].first));
+  threaded.done();
   for (const auto& w : work_)
     if (!w->failure.empty()) return 1.0;
   // Free velocities: the grains' current iterates without their contact impulses (method.md §4).
@@ -1153,7 +1160,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   contact::GsResult r;
   {
     ScopedStage t(&timers_, "contact.gs");
-    r = contact::solve_gauss_seidel(problem_, settings_.contact.gs);
+    r = contact::solve_gauss_seidel(problem_, gs_settings());
   }
   stats.gs_sweeps += r.sweeps;
   stats.gs_error = r.error;
@@ -1247,6 +1254,7 @@ void ImplicitSolver<Dim>::commit() {
   ScopedStage t(&timers_, "g2p");
   const std::size_t no = owned_.size();
   const bool linear = settings_.shape == grid::ShapeKind::kLinear;
+  const ThreadedRegion threaded(&timers_, no > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (no > 1)
   for (std::size_t i = 0; i < no; ++i) {
     const std::size_t g = owned_[i];
@@ -1638,12 +1646,12 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
       den = v[1];
     };
     ScopedStage t(&timers_, "contact.gs");
-    r = contact::solve_gauss_seidel(problem_, settings_.contact.gs, reduce);
+    r = contact::solve_gauss_seidel(problem_, gs_settings(), reduce);
   } else {
     r.converged = true;  // ranks other than 0 hold no contact
     if (comm_->rank() == 0) {
       ScopedStage t(&timers_, "contact.gs");
-      r = contact::solve_gauss_seidel(problem_, settings_.contact.gs);
+      r = contact::solve_gauss_seidel(problem_, gs_settings());
       comm_->count_work(kContactPassWeight * (1.0 + 2.0 * r.sweeps) *
                         static_cast<double>(problem_.contacts.size()));
     }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "mpmcd/core/timer.hpp"
 #include "mpmcd/core/types.hpp"
 
 namespace mpmcd::contact {
@@ -57,6 +58,8 @@ struct Problem {
 struct GsSettings {
   double tolerance = 1e-8;  ///< stop when error(problem) <= tolerance [-]
   int max_sweeps = 1000;    ///< sweep limit [-]
+  /// Where the threaded sweeps and error sums add their time (ThreadedRegion); none if null.
+  StageTimers* timers = nullptr;
 };
 
 /// Gauss-Seidel outcome.
@@ -100,7 +103,8 @@ using ErrorReduce = std::function<void(double& num, double& den)>;
 
 /// The two sums of error(problem): num = sum_c |P_c - local_c(P)|^2, den = sum_c |P_c|^2 [(N s)^2].
 template <int Dim>
-void error_terms(const Problem<Dim>& problem, double& num, double& den);
+void error_terms(const Problem<Dim>& problem, double& num, double& den,
+                 StageTimers* timers = nullptr);
 
 /// Gauss-Seidel on this process's part of a distributed problem (docs/parallel.md): the same sweeps
 /// as solve_gauss_seidel over the local contacts, with the error summed over all parts by `reduce`

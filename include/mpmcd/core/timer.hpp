@@ -1,5 +1,6 @@
 #pragma once
 /// Wall-clock stage timers: accumulate seconds per named stage.
+#include <omp.h>
 #include <time.h>
 
 #include <chrono>
@@ -42,8 +43,11 @@ class ScopedStage {
   /// Starts timing stage `name` into `timers`.
   ScopedStage(StageTimers* timers, const char* name)
       : timers_(timers), name_(name), start_(timers ? timers->now() : 0.0) {}
-  ~ScopedStage() {
+  ~ScopedStage() { done(); }
+  /// Adds the time so far and stops (the destructor then adds nothing).
+  void done() {
     if (timers_) timers_->add(name_, timers_->now() - start_);
+    timers_ = nullptr;
   }
   ScopedStage(const ScopedStage&) = delete;
   ScopedStage& operator=(const ScopedStage&) = delete;
@@ -52,6 +56,27 @@ class ScopedStage {
   StageTimers* timers_;
   const char* name_;
   double start_;
+};
+
+/// Name of the stage that ThreadedRegion fills: wall time in OpenMP regions that ran on more
+/// than one thread (nested in the other stages; docs/parallel.md, one-thread share).
+inline constexpr const char* kThreadedStage = "threads";
+
+/// RAII around one OpenMP region, constructed just before its `#pragma omp parallel` with the
+/// region's `if` condition: adds the region's wall time [s] to stage kThreadedStage of `timers`
+/// when the region runs on more than one thread (no-op if timers is null).
+class ThreadedRegion {
+ public:
+  /// Starts timing if `parallel` holds, more than one thread is available and no region is open.
+  ThreadedRegion(StageTimers* timers, bool parallel)
+      : stage_(parallel && timers && omp_get_max_threads() > 1 && !omp_in_parallel() ? timers
+                                                                                     : nullptr,
+               kThreadedStage) {}
+  /// Stops timing now (the region has ended; the rest of the scope runs on one thread).
+  void done() { stage_.done(); }
+
+ private:
+  ScopedStage stage_;
 };
 
 }  // namespace mpmcd

@@ -53,7 +53,7 @@ struct StageTime {
   double min = 0;           ///< smallest over ranks [s]
   double serial = 0;        ///< stage-total imbalance: max - second largest of work [s]
   bool nested = false;      ///< inside another stage (not added to the step total)
-  bool one_thread = false;  ///< runs on one thread per rank
+  bool one_thread = false;  ///< mostly on one thread per rank (the measured share: below)
 };
 
 /// Gathers every rank's stage totals [s] and derives the report (collective call).
@@ -66,5 +66,12 @@ std::vector<StageTime> stage_report(const Comm& comm, const std::map<std::string
 std::string stage_report_csv(const std::vector<StageTime>& rows, double wall_seconds, int ranks,
                              int threads, long long steps, double bytes_per_rank_step,
                              const Comm::SoloReport& solo);
+
+/// Measured share of the wall time in which a rank works on one thread only [-]: the wall time
+/// minus its time in OpenMP regions that ran on several threads (stage kThreadedStage, mean over
+/// ranks) and minus its time waiting in synchronisations (`solo.wait_s`), over the wall time;
+/// 0 with one thread. Load imbalance between the threads inside a region is not in it.
+double one_thread_fraction(const std::vector<StageTime>& rows, double wall_seconds, int threads,
+                           const Comm::SoloReport& solo);
 
 }  // namespace mpmcd::parallel

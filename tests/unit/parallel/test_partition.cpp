@@ -6,6 +6,7 @@
 #include <random>
 
 #include "mpmcd/parallel/comm.hpp"
+#include "mpmcd/parallel/distribute.hpp"
 #include "mpmcd/parallel/partition.hpp"
 
 using namespace mpmcd::parallel;
@@ -123,4 +124,19 @@ TEST(Comm, SerialWithoutMpirunIsOneRank) {
   EXPECT_EQ(b.get<double>(), 4.5);
   EXPECT_TRUE(b.done());
   Comm::finalize();
+}
+
+TEST(StageReport, OneThreadShareIsWallMinusThreadedRegionsAndWaits) {
+  using mpmcd::parallel::StageTime;
+  std::vector<StageTime> rows(2);
+  rows[0].name = "newton.solve";
+  rows[0].mean = 0.9;
+  rows[1].name = mpmcd::kThreadedStage;
+  rows[1].mean = 0.6;
+  mpmcd::parallel::Comm::SoloReport solo;
+  solo.wait_s = 0.1;
+  EXPECT_NEAR(mpmcd::parallel::one_thread_fraction(rows, 1.0, 2, solo), 0.3, 1e-15);
+  EXPECT_EQ(mpmcd::parallel::one_thread_fraction(rows, 1.0, 1, solo), 0.0);  // one thread
+  solo.wait_s = 0.5;  // clamped at 0 (timer rounding)
+  EXPECT_EQ(mpmcd::parallel::one_thread_fraction(rows, 1.0, 2, solo), 0.0);
 }
