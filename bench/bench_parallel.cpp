@@ -170,11 +170,10 @@ int main(int argc, char** argv) {
       std::ofstream out(csv, std::ios::app);
       if (fresh)
         out << "scheme,ranks,threads,points,steps,step_ms,work_max_ms,serial_fraction,"
-               "stage_imbalance_fraction,solo_ms,solo_cpu_ms,counted_serial_fraction,sync_wait_"
-               "fraction,one_thread_"
-               "fraction,"
-               "bytes_per_rank_step,bytes_max_rank_step,rebalance_bytes_per_rank_step,contacts,gs_"
-               "sweeps,newton_it,stages\n";
+               "stage_imbalance_fraction,solo_ms,solo_cpu_ms,counted_serial_fraction,"
+               "sync_wait_fraction,one_thread_fraction,"
+               "bytes_per_rank_step,bytes_max_rank_step,rebalance_bytes_per_rank_step,"
+               "contacts,gs_sweeps,newton_it,stages\n";
       out << line;
     }
   }

@@ -11,6 +11,17 @@ namespace mpmcd::app {
 
 namespace {
 
+// Σ_{p in g} vol_p of each grain g (zero for grains another rank owns when `owner` is given).
+std::vector<double> per_grain_sums(const mpm::Model<2>& model, const std::vector<double>& vol,
+                                   const std::vector<int>* owner, int rank) {
+  std::vector<double> sums(model.grains.size(), 0.0);
+  for (std::size_t g = 0; g < sums.size(); ++g) {
+    if (owner && (*owner)[g] != rank) continue;
+    for (std::int64_t p = model.grains[g].begin; p < model.grains[g].end; ++p) sums[g] += vol[p];
+  }
+  return sums;
+}
+
 // Vs = Σ_g Σ_{p in g} V_p (current volumes).
 double grain_area(const mpm::Model<2>& model) {
   return CompactionObserver::total_area(CompactionObserver::grain_areas(model));
@@ -19,11 +30,7 @@ double grain_area(const mpm::Model<2>& model) {
 // Vs0 = Σ_g Σ_{p in g} V0_p: the initial grain area, also after a restart (equal bit for bit to
 // grain_area at t = 0, where V_p = V0_p: the same association).
 double reference_grain_area(const mpm::Model<2>& model) {
-  std::vector<double> area(model.grains.size(), 0.0);
-  for (std::size_t g = 0; g < area.size(); ++g)
-    for (std::int64_t p = model.grains[g].begin; p < model.grains[g].end; ++p)
-      area[g] += model.points.volume0[p];
-  return CompactionObserver::total_area(area);
+  return CompactionObserver::total_area(per_grain_sums(model, model.points.volume0, nullptr, 0));
 }
 
 Vec<2> force_on(const mpm::StepStats& step, std::size_t k) {
@@ -106,13 +113,7 @@ std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm
 
 std::vector<double> CompactionObserver::grain_areas(const mpm::Model<2>& model,
                                                     const std::vector<int>* owner, int rank) {
-  std::vector<double> area(model.grains.size(), 0.0);
-  for (std::size_t g = 0; g < area.size(); ++g) {
-    if (owner && (*owner)[g] != rank) continue;
-    for (std::int64_t p = model.grains[g].begin; p < model.grains[g].end; ++p)
-      area[g] += model.points.volume[p];
-  }
-  return area;
+  return per_grain_sums(model, model.points.volume, owner, rank);
 }
 
 double CompactionObserver::total_area(const std::vector<double>& areas) {
