@@ -203,6 +203,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
   s.cg_tolerance = cfg.solver.cg_tolerance;
   s.cg_max_iterations = cfg.solver.cg_max_iterations;
   s.flip = cfg.solver.flip;
+  s.affine = cfg.solver.affine;
   if (cfg.loads.gravity.size() == 2) s.gravity = vec2(cfg.loads.gravity);
   // Contact: enabled when asked and there is something to touch (two grains or a wall).
   auto& c = s.contact;
@@ -216,6 +217,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
   c.gs.max_sweeps = cfg.contact.max_sweeps;
   c.impulse_tolerance = cfg.contact.impulse_tolerance;
   c.wall_range = cfg.contact.wall_range;
+  c.wall_points = cfg.contact.wall_contact == "points";
   // Delassus operator: the lumped 1/m_I is accurate when inertia dominates a step (theta c_p dt/h
   // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered
   // contact-Newton loop converging in a few iterations.
@@ -509,12 +511,14 @@ mpm::Model<2> restore_model(const io::Config& cfg, const checkpoint::State& s,
   auto& p = model.points;
   p.x.resize(n);
   p.v.resize(n);
+  p.L.resize(n);
   p.F.resize(n);
   p.sigma.resize(n);
   p.domain.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     p.x[i] = Vec<2>(s.x[2 * i], s.x[2 * i + 1]);
     p.v[i] = Vec<2>(s.v[2 * i], s.v[2 * i + 1]);
+    p.L[i] << s.L[4 * i], s.L[4 * i + 1], s.L[4 * i + 2], s.L[4 * i + 3];
     p.F[i] << s.F[4 * i], s.F[4 * i + 1], s.F[4 * i + 2], s.F[4 * i + 3];
     p.sigma[i] << s.sigma[4 * i], s.sigma[4 * i + 1], s.sigma[4 * i + 2], s.sigma[4 * i + 3];
     p.domain[i] << s.domain[4 * i], s.domain[4 * i + 1], s.domain[4 * i + 2], s.domain[4 * i + 3];
@@ -546,8 +550,8 @@ mpm::Model<2> restore_model(const io::Config& cfg, const checkpoint::State& s,
   const auto ng = static_cast<std::int32_t>(model.grains.size());
   const auto nwall = static_cast<std::int32_t>(cfg.walls.size());
   for (std::size_t k = 0; k < s.warm_node.size(); ++k)
-    if (s.warm_node[k] < 0 || s.warm_node[k] >= model.grid.node_count() || s.warm_b[k] < 0 ||
-        s.warm_b[k] >= ng || s.warm_a[k] >= ng || s.warm_a[k] < -nwall)
+    if (s.warm_node[k] < -model.grid.node_count() || s.warm_node[k] >= model.grid.node_count() ||
+        s.warm_b[k] < 0 || s.warm_b[k] >= ng || s.warm_a[k] >= ng || s.warm_a[k] < -nwall)
       throw refuse(
           fmt::format("contact warm-start entry {} names a node or body that does not "
                       "exist",
@@ -716,6 +720,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     const std::size_t n = p.size();
     s.x.resize(2 * n);
     s.v.resize(2 * n);
+    s.L.resize(4 * n);
     s.F.resize(4 * n);
     s.sigma.resize(4 * n);
     s.domain.resize(4 * n);
@@ -724,6 +729,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
         s.x[2 * i + a] = p.x[i][a];
         s.v[2 * i + a] = p.v[i][a];
         for (int b = 0; b < 2; ++b) {
+          s.L[4 * i + 2 * a + b] = p.L[i](a, b);
           s.F[4 * i + 2 * a + b] = p.F[i](a, b);
           s.sigma[4 * i + 2 * a + b] = p.sigma[i](a, b);
           s.domain[4 * i + 2 * a + b] = p.domain[i](a, b);

@@ -268,7 +268,7 @@ std::uint64_t payload_checksum(const State& s) {
     h = hash_value(v, h);
   for (auto v : {s.time, s.dt, s.next_vtu, s.next_csv}) h = hash_value(v, h);
   for (const auto* a :
-       {&s.vtu_times, &s.x, &s.v, &s.F, &s.sigma, &s.domain, &s.sigma_zz, &s.mass, &s.volume0,
+       {&s.vtu_times, &s.x, &s.v, &s.L, &s.F, &s.sigma, &s.domain, &s.sigma_zz, &s.mass, &s.volume0,
         &s.volume, &s.history, &s.grain_half_width, &s.warm_impulse, &s.wall_point, &s.grain_work})
     h = hash_array(*a, h);
   for (const auto* a : {&s.grain, &s.grain_material, &s.warm_a, &s.warm_b, &s.grain_owner})
@@ -311,6 +311,7 @@ void write(const State& s, const std::string& path) {
     w.group("/points");
     w.array("/points/x", s.x, {n, d});
     w.array("/points/v", s.v, {n, d});
+    w.array("/points/L", s.L, {n, d, d});
     w.array("/points/F", s.F, {n, d, d});
     w.array("/points/sigma", s.sigma, {n, d, d});
     w.array("/points/domain", s.domain, {n, d, d});
@@ -433,6 +434,7 @@ State read(const std::string& path) {
   const hsize_t n = s.grain.size();
   s.x = r.array<double>("/points/x", {n, d});
   s.v = r.array<double>("/points/v", {n, d});
+  s.L = r.array<double>("/points/L", {n, d, d});
   s.F = r.array<double>("/points/F", {n, d, d});
   s.sigma = r.array<double>("/points/sigma", {n, d, d});
   s.domain = r.array<double>("/points/domain", {n, d, d});

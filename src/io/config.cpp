@@ -129,7 +129,7 @@ Schema build_schema() {
             .greater_than(0.0),
         KeySpec::number("cell_size", "m", "cell edge length h").require().greater_than(0.0),
         KeySpec::string("shape_function", "MPM shape functions")
-            .one_of({"linear", "ugimp"})
+            .one_of({"linear", "ugimp", "cpdi"})
             .defaults(str(d.grid.shape_function))},
        ""});
 
@@ -285,7 +285,12 @@ Schema build_schema() {
         KeySpec::number("flip", "", "FLIP fraction of the G2P velocity update (1 FLIP, 0 PIC)")
             .at_least(0.0)
             .at_most(1.0)
-            .defaults(num(d.solver.flip))},
+            .defaults(num(d.solver.flip)),
+        KeySpec::boolean("affine",
+                         "affine P2G: each point carries its velocity gradient L and gives its "
+                         "nodes m N (v + L (x_I - x_p)) (APIC/TPIC), so that linear velocity "
+                         "fields cross the grid exactly")
+            .defaults(boolean_text(d.solver.affine))},
        ""});
 
   s.tables.push_back(
@@ -323,6 +328,13 @@ Schema build_schema() {
             .greater_than(0.0)
             .at_most(3.0)
             .defaults(num(d.contact.wall_range)),
+        KeySpec::string("wall_contact",
+                        "where a wall acts: \"nodes\" (a grain node's velocity may not cross "
+                        "it) or \"points\" (the velocity of each point domain's face toward it, "
+                        "interpolated from the nodes, may not cross it: holds the material edge at "
+                        "the wall; one MPI rank only for now; docs/accuracy.md)")
+            .one_of({"nodes", "points"})
+            .defaults(str(d.contact.wall_contact)),
         KeySpec::string("delassus",
                         "contact compliance: \"grain\" (each grain's exact linearised response "
                         "from its factorised Newton matrix; direct solvers), \"lumped\" (1/m_I), "
@@ -730,6 +742,7 @@ class ConfigReader {
     r.read("cg_tolerance", s.cg_tolerance);
     r.read("cg_max_iterations", s.cg_max_iterations);
     r.read("flip", s.flip);
+    r.read("affine", s.affine);
   }
 
   void read_contact(const TableReader& root, Config& c) {
@@ -743,6 +756,7 @@ class ConfigReader {
     r.read("max_sweeps", k.max_sweeps);
     r.read("impulse_tolerance", k.impulse_tolerance);
     r.read("wall_range", k.wall_range);
+    r.read("wall_contact", k.wall_contact);
     r.read("delassus", k.delassus);
     const auto tables = r.table_array("pairs");
     for (std::size_t i = 0; i < tables.size(); ++i) {

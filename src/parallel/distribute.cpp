@@ -41,6 +41,7 @@ void gather_points(const Comm& comm, points::PointSet<Dim>& points,
     for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
       mine.put(points.x[p]);
       mine.put(points.v[p]);
+      mine.put(points.L[p]);
       mine.put(points.F[p]);
       mine.put(points.sigma[p]);
       mine.put(points.sigma_zz[p]);
@@ -74,6 +75,7 @@ void gather_points(const Comm& comm, points::PointSet<Dim>& points,
       for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
         points.x[p] = b.template get<Vec<Dim>>();
         points.v[p] = b.template get<Vec<Dim>>();
+        points.L[p] = b.template get<Mat<Dim>>();
         points.F[p] = b.template get<Mat<Dim>>();
         points.sigma[p] = b.template get<Mat<Dim>>();
         points.sigma_zz[p] = b.template get<double>();
@@ -168,7 +170,7 @@ template contact::Problem<2> gather_contacts<2>(const Comm&, const contact::Prob
 template contact::Problem<3> gather_contacts<3>(const Comm&, const contact::Problem<3>&, int);
 
 namespace {
-// Appends / reads the committed state of grain g (x, v, F, sigma, sigma_zz, volume, history).
+// Appends / reads the committed state of grain g (x, v, L, F, sigma, sigma_zz, volume, history).
 template <int Dim>
 void put_grain(Buffer& b, const points::PointSet<Dim>& points,
                const std::vector<points::Grain>& grains, std::size_t g) {
@@ -177,6 +179,7 @@ void put_grain(Buffer& b, const points::PointSet<Dim>& points,
   for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
     b.put(points.x[p]);
     b.put(points.v[p]);
+    b.put(points.L[p]);
     b.put(points.F[p]);
     b.put(points.sigma[p]);
     b.put(points.sigma_zz[p]);
@@ -192,6 +195,7 @@ void get_grain(Buffer& b, points::PointSet<Dim>& points, const std::vector<point
   for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
     points.x[p] = b.template get<Vec<Dim>>();
     points.v[p] = b.template get<Vec<Dim>>();
+    points.L[p] = b.template get<Mat<Dim>>();
     points.F[p] = b.template get<Mat<Dim>>();
     points.sigma[p] = b.template get<Mat<Dim>>();
     points.sigma_zz[p] = b.template get<double>();

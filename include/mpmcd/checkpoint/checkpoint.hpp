@@ -12,7 +12,7 @@
 namespace mpmcd::checkpoint {
 
 /// Layout version of the files this build writes and reads [-].
-inline constexpr std::int32_t kFormatVersion = 3;
+inline constexpr std::int32_t kFormatVersion = 4;
 
 /// FNV-1a 64-bit offset basis (start value of fnv1a) [-].
 inline constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
@@ -45,6 +45,7 @@ struct State {
   // Material points (points::PointSet).
   std::vector<double> x;            ///< positions, n x dim [m]
   std::vector<double> v;            ///< velocities, n x dim [m/s]
+  std::vector<double> L;            ///< velocity gradients (affine P2G), n x dim x dim [1/s]
   std::vector<double> F;            ///< deformation gradients, n x dim x dim [-]
   std::vector<double> sigma;        ///< Cauchy stresses, n x dim x dim [Pa]
   std::vector<double> domain;       ///< reference domain half-edges (columns), n x dim x dim [m]

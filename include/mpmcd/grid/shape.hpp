@@ -1,6 +1,8 @@
 #pragma once
-/// Shape functions as tensor products of 1D weights (method.md §1): linear hat functions and
-/// uniform GIMP (uGIMP, Bardenhagen & Kober 2004) with a fixed particle half-width lp.
+/// Shape functions (method.md §1): tensor products of 1D weights (linear hat functions and uniform
+/// GIMP, uGIMP, Bardenhagen & Kober 2004, with a fixed particle half-width lp), and CPDI1
+/// (Sadeghirad, Brannon & Burghardt 2011), whose point domains follow the deformation gradient.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -10,9 +12,9 @@
 namespace mpmcd::grid {
 
 /// Shape-function family, chosen in the input ([grid] shape_function).
-enum class ShapeKind { kLinear, kUGimp };
+enum class ShapeKind { kLinear, kUGimp, kCpdi };
 
-/// Parses "linear" / "ugimp"; throws InputError otherwise.
+/// Parses "linear" / "ugimp" / "cpdi"; throws InputError otherwise.
 ShapeKind shape_kind_from_string(const std::string& name);
 
 /// 1D linear hat weights: N(d) = 1 - |d|/h on two nodes.
@@ -86,6 +88,13 @@ struct PointShape {
     for (int e = 0; e < d; ++e) a /= S1::kNodes;
     return a % S1::kNodes;
   }
+  /// Same as eval(x, origin, h, lp); the current domain is not used by these functions. Always
+  /// true (the support is always kNodes per axis).
+  bool eval(const Vec<Dim>& x, const Vec<Dim>& origin, double h, double lp,
+            const Mat<Dim>& /*domain*/) {
+    eval(x, origin, h, lp);
+    return true;
+  }
   /// Evaluates at x [m] on a grid of `origin` [m], cell size `h` [m], uGIMP half-width `lp` [m].
   void eval(const Vec<Dim>& x, const Vec<Dim>& origin, double h, double lp) {
     double n1[Dim][S1::kNodes], d1[Dim][S1::kNodes];
@@ -106,6 +115,93 @@ struct PointShape {
       }
     }
   }
+};
+
+/// Tag of the CPDI1 family: a point's support is a window of 3 nodes per axis (the cells holding
+/// the corners of its domain, which must span at most two cells per axis).
+struct Cpdi1D {
+  static constexpr int kNodes = 3;  ///< nodes per axis in the support window
+};
+
+/// CPDI1 weights of one point (Sadeghirad et al. 2011, eqs. 31-32, written for any Dim): the
+/// point's domain is the parallelepiped x_p + D s, s in [-1, 1]^Dim, D = F D0 (columns: current
+/// half-edge vectors [m]); with the linear hat N_I at its 2^Dim corners x_c = x_p + D s_c,
+///   N_I(x_p)      = 2^-Dim sum_c N_I(x_c)                 (mean of the corner interpolant),
+///   grad N_I(x_p) = 2^-Dim D^-T sum_c s_c N_I(x_c)         (exact mean of its gradient).
+/// Domains that tile a body keep tiling it under any homogeneous F, so a uniform stress gives no
+/// force at interior nodes whatever the points' positions relative to the grid lines.
+template <int Dim>
+struct CpdiShape {
+  static constexpr int K = support_size<Dim, Cpdi1D>();  ///< support window size (3^Dim)
+  IVec<Dim> first;                                       ///< integer coordinates of the first node
+  double N[K];                                           ///< weights, sum = 1 [-]
+  Vec<Dim> dN[K];                                        ///< gradients [1/m]
+  /// Offset of window node a along axis d (0 .. 2).
+  static int offset(int a, int d) { return PointShape<Dim, Cpdi1D>::offset(a, d); }
+  /// Evaluates at x [m] for the current domain D [m] (columns: half-edges) on a grid of `origin`
+  /// [m] and cell size `h` [m]; false if the corners span more than two cells along an axis.
+  bool eval(const Vec<Dim>& x, const Vec<Dim>& origin, double h, double /*lp*/,
+            const Mat<Dim>& domain) {
+    constexpr int nc = 1 << Dim;
+    Vec<Dim> xi[nc];
+    for (int c = 0; c < nc; ++c) {
+      Vec<Dim> s;
+      for (int d = 0; d < Dim; ++d) s[d] = (c >> d) & 1 ? 1.0 : -1.0;
+      xi[c] = (x + domain * s - origin) / h;
+    }
+    for (int d = 0; d < Dim; ++d) {
+      double lo = xi[0][d];
+      for (int c = 1; c < nc; ++c) lo = std::min(lo, xi[c][d]);
+      first[d] = static_cast<std::int64_t>(std::floor(lo));
+    }
+    Vec<Dim> ssum[K];
+    for (int a = 0; a < K; ++a) {
+      N[a] = 0.0;
+      ssum[a].setZero();
+    }
+    for (int c = 0; c < nc; ++c) {
+      // Linear hat weights of corner c on the 2^Dim nodes of its cell, placed in the window.
+      int o[Dim];
+      double t[Dim];
+      for (int d = 0; d < Dim; ++d) {
+        double f = std::floor(xi[c][d]);
+        // A corner on the window's last grid line belongs to the cell below it (weight 1 there).
+        if (f - static_cast<double>(first[d]) > 1.5 && xi[c][d] - f < 1e-12) f -= 1.0;
+        o[d] = static_cast<int>(f - static_cast<double>(first[d]));
+        if (o[d] < 0 || o[d] > 1) return false;
+        t[d] = xi[c][d] - f;
+      }
+      for (int b = 0; b < nc; ++b) {
+        double w = 1.0;
+        int a = 0, mul = 1;
+        for (int d = 0; d < Dim; ++d) {
+          const int up = (b >> d) & 1;
+          w *= up ? t[d] : 1.0 - t[d];
+          a += (o[d] + up) * mul;
+          mul *= 3;
+        }
+        N[a] += w;
+        for (int d = 0; d < Dim; ++d) ssum[a][d] += ((c >> d) & 1 ? w : -w);
+      }
+    }
+    const Mat<Dim> dinvT = domain.inverse().transpose();
+    for (int a = 0; a < K; ++a) {
+      N[a] /= nc;
+      dN[a] = dinvT * ssum[a] / nc;
+    }
+    return true;
+  }
+};
+
+/// The point-shape type of a family tag: PointShape for Linear1D / UGimp1D, CpdiShape for Cpdi1D.
+template <int Dim, class S1>
+struct ShapeOf {
+  using type = PointShape<Dim, S1>;  ///< tensor-product shape
+};
+/// CPDI1 specialisation.
+template <int Dim>
+struct ShapeOf<Dim, Cpdi1D> {
+  using type = CpdiShape<Dim>;  ///< CPDI1 shape
 };
 
 }  // namespace mpmcd::grid

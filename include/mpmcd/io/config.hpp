@@ -96,7 +96,8 @@ struct SolverSection {
   std::string linear_solver = "ldlt";  ///< "ldlt" (sparse direct), "lu" or "cg" (Jacobi CG)
   double cg_tolerance = 1e-12;         ///< relative residual of the CG solve [-]
   int cg_max_iterations = 1000;        ///< CG iteration limit [-]
-  double flip = 1.0;  ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
+  double flip = 1.0;    ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
+  bool affine = false;  ///< affine P2G with the points' velocity gradients (APIC/TPIC)
 };
 
 /// [[contact.pairs]]: friction between two materials.
@@ -116,7 +117,8 @@ struct ContactSection {
   int max_sweeps = 1000;          ///< Gauss-Seidel sweep limit [-]
   double impulse_tolerance = 1e-6;  ///< relative impulse change between Newton iterations [-]
   double wall_range = 1.0;          ///< grain nodes within this many cells of a wall take part [-]
-  std::string delassus = "auto";    ///< "grain" (exact grain compliance), "lumped" or "auto"
+  std::string wall_contact = "nodes";     ///< where walls act: "nodes" or "points" (point faces)
+  std::string delassus = "auto";          ///< "grain" (exact grain compliance), "lumped" or "auto"
   std::vector<ContactPairSection> pairs;  ///< per material-pair friction
 };
 

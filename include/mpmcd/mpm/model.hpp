@@ -45,6 +45,18 @@ struct Model {
           densities[material] * seeds.volume[i], seeds.volume[i],
           seeds.domain.empty() ? Mat<Dim>(half_width * Mat<Dim>::Identity()) : seeds.domain[i], gi);
     g.end = static_cast<std::int64_t>(points.size());
+    // Velocity gradient of the initial field by central differences over 1e-3 of the point's
+    // half-width (exact to round-off for the affine parts), for the affine P2G.
+    if (velocity)
+      for (std::int64_t p = g.begin; p < g.end; ++p) {
+        const double e = 1e-3 * half_width;
+        for (int d = 0; d < Dim; ++d) {
+          Vec<Dim> xp = points.x[p], xm = points.x[p];
+          xp[d] += e;
+          xm[d] -= e;
+          points.L[p].col(d) = (velocity(xp) - velocity(xm)) / (2 * e);
+        }
+      }
     const std::size_t hs = static_cast<std::size_t>(laws[material]->history_size());
     const std::size_t h0 = points.history.size();
     points.history.resize(h0 + hs * seeds.x.size());

@@ -60,9 +60,14 @@ struct ContactSettings {
       1e-3;           ///< a field takes part at a node above this fraction of a cell's mass
   int materials = 1;  ///< number of materials (size of the friction matrix)
   std::vector<double> friction = {
-      0.0};                         ///< mu_f per material pair, row-major materials x materials
-  std::vector<Wall<Dim>> walls;     ///< rigid walls
-  double wall_range = 1.0;          ///< grain nodes within this many cells of a wall are candidates
+      0.0};                      ///< mu_f per material pair, row-major materials x materials
+  std::vector<Wall<Dim>> walls;  ///< rigid walls
+  double wall_range = 1.0;       ///< grain nodes within this many cells of a wall are candidates
+  /// Where a wall acts (docs/accuracy.md): false = at grain nodes (the node velocity may not
+  /// cross the wall), true = at the faces of the points' domains facing the wall (the velocity
+  /// of the face, interpolated from the nodes, may not cross it), which holds the material edge,
+  /// not a node beyond it, at the wall. Points within wall_range cells of a wall are candidates.
+  bool wall_points = false;
   contact::GsSettings gs;           ///< Gauss-Seidel tolerance and sweep limit
   double impulse_tolerance = 1e-6;  ///< relative change of impulses between Newton iterations [-]
   /// Delassus operator: true = each grain's exact compliance at its contact nodes from its
@@ -81,7 +86,11 @@ struct Settings {
   LinearSolverKind linear_solver = LinearSolverKind::kLdlt;  ///< per-grain linear solver
   double cg_tolerance = 1e-12;                               ///< relative CG residual [-]
   int cg_max_iterations = 1000;                              ///< CG iteration cap [-]
-  double flip = 1.0;                    ///< FLIP fraction of the G2P velocity update [-]
+  double flip = 1.0;  ///< FLIP fraction of the G2P velocity update [-]
+  /// Affine P2G (APIC, Jiang et al. 2015, with the velocity gradient as the affine matrix, as in
+  /// TPIC, Nakamura et al. 2023): m_I v_I = sum N m_p (v_p + L_p (x_I - x_p)), L_p carried by the
+  /// points, so that a linear velocity field is transferred exactly whatever the positions.
+  bool affine = false;
   Vec<Dim> gravity = Vec<Dim>::Zero();  ///< body acceleration [m/s^2]
   ContactSettings<Dim> contact;         ///< contact between grains and with walls
 };
@@ -119,9 +128,9 @@ struct StepStats {
 /// A contact impulse of the last converged step, used to warm start the next one.
 template <int Dim>
 struct WarmImpulse {
-  std::int64_t node = 0;                ///< global grid node [-]
-  std::int32_t a = 0;                   ///< body a: grain >= 0 or wall -1 - index [-]
-  std::int32_t b = 0;                   ///< grain b [-]
+  std::int64_t node = 0;  ///< global grid node, or -1 - grid cell of a face contact [-]
+  std::int32_t a = 0;     ///< body a: grain >= 0 or wall -1 - index [-]
+  std::int32_t b = 0;     ///< grain b [-]
   Vec<Dim> impulse = Vec<Dim>::Zero();  ///< impulse on b over the step [N s] (2D: N s/m)
 };
 
@@ -202,6 +211,15 @@ class ImplicitSolver {
   void detect_contacts(double dt);
   double update_contacts(StepStats& stats);
   std::int32_t slot_of(std::int32_t g, std::int32_t a);
+  // A slot for the faces of points `pts` of grain g facing a wall of unit normal n (into the
+  // domain): the mean velocity of the face centres interpolated from g's active nodes. Writes the
+  // mean face centre to x_face [m]; -1 if the faces touch no active node.
+  std::int32_t face_slot(std::int32_t g, const std::vector<std::int64_t>& pts, const Vec<Dim>& n,
+                         Vec<Dim>& x_face);
+  // Velocity of slot s from its grain's current nodal iterate: sum_k w_k v_{a_k} [m/s].
+  Vec<Dim> slot_velocity(std::size_t s) const;
+  // Nodal impulses of every grain from the slots' impulses slot_P_: P_a = sum_s w_sa P_s.
+  void spread_slot_impulses();
   // Agrees on the lowest failing grain over the ranks (reduced here when `lowest` < 0, else that
   // grain) and gives every rank its owner's failure message; false when no rank failed.
   bool sync_failure(StepStats& stats, std::int64_t lowest = -1);
@@ -230,6 +248,14 @@ class ImplicitSolver {
   // Contact state: the problem of the step, slot -> (grain, active node), warm-start impulses.
   contact::Problem<Dim> problem_;
   std::vector<std::pair<std::int32_t, std::int32_t>> slot_ref_;
+  // Per slot: its grain's active nodes and weights (CSR; a node slot has one node of weight 1),
+  // and the impulse it currently applies to its grain [N s].
+  std::vector<std::int32_t> slot_start_{0}, slot_node_;
+  std::vector<double> slot_weight_;
+  std::vector<Vec<Dim>> slot_P_;
+  std::vector<char> slot_is_face_;
+  // Per slot: warm-start key, the global node of a node slot, -1 - cell of a face slot.
+  std::vector<std::int64_t> slot_key_;
   std::vector<std::uint32_t> node_stamp_, slot_stamp_;  // per global node: step stamp
   std::vector<std::int32_t> node_head_, slot_head_;     // per global node: first entry / slot
   std::vector<std::int32_t> slot_next_;                 // per slot: next slot at the same node

@@ -23,6 +23,7 @@ template <int Dim>
 struct PointSet {
   std::vector<Vec<Dim>> x;          ///< position [m]
   std::vector<Vec<Dim>> v;          ///< velocity [m/s]
+  std::vector<Mat<Dim>> L;          ///< velocity gradient carried for the affine P2G [1/s]
   std::vector<Mat<Dim>> F;          ///< deformation gradient [-]
   std::vector<Mat<Dim>> sigma;      ///< Cauchy stress (in-plane part) [Pa]
   std::vector<double> sigma_zz;     ///< out-of-plane Cauchy stress in plane strain (2D) [Pa]
@@ -41,6 +42,7 @@ struct PointSet {
            std::int32_t g) {
     x.push_back(pos);
     v.push_back(vel);
+    L.push_back(Mat<Dim>::Zero());
     F.push_back(Mat<Dim>::Identity());
     sigma.push_back(Mat<Dim>::Zero());
     sigma_zz.push_back(0.0);

@@ -53,6 +53,7 @@ ck::State sample() {
     s.x.insert(s.x.end(), {a * 1e-3, std::nextafter(a * 2e-3, 1.0)});
     s.v.insert(s.v.end(), {-a, a / 7});
     s.F.insert(s.F.end(), {1 + a / 1e3, 1e-4, -2e-4, 1 - a / 1e3});
+    s.L.insert(s.L.end(), {a / 7.0, -1e-3, 2e-3, -a / 9.0});
     s.sigma.insert(s.sigma.end(), {a * 1e3, 5.0, 5.0, -a * 1e3});
     s.domain.insert(s.domain.end(), {2.5e-5, 1e-6, -1e-6, 2.5e-5 * a});
     s.sigma_zz.push_back(a * 10);
@@ -153,6 +154,7 @@ TEST(Checkpoint, RoundTripIsBitwise) {
   EXPECT_TRUE(same(r.x, s.x));
   EXPECT_TRUE(same(r.v, s.v));
   EXPECT_TRUE(same(r.F, s.F));
+  EXPECT_TRUE(same(r.L, s.L));
   EXPECT_TRUE(same(r.sigma, s.sigma));
   EXPECT_TRUE(same(r.domain, s.domain));
   EXPECT_TRUE(same(r.sigma_zz, s.sigma_zz));

@@ -1,0 +1,122 @@
+// A Neo-Hookean block squeezed between four frictionless walls, loaded as users load it (walls
+// and contact, points crossing grid lines), against the closed form of method.md §7: it starts
+// with the exact homogeneous velocity v_y = -V (y - y0)/H0 (zero acceleration), so F = diag(1, s)
+// at every point and every instant, sigma22 = [mu (s^2 - 1) + lambda ln s] / s, the top wall
+// force is -sigma22 times the width, and the elastic energy is the work of the top wall (minus
+// the backward-Euler dissipation of the right-endpoint rule, O(dt)). docs/accuracy.md says which
+// parts of the method each check needs: CPDI domains that follow F, the affine P2G, and walls that
+// act on the points' faces.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <tuple>
+
+#include "../../support/builders.hpp"
+
+using namespace mpmcd;
+
+namespace {
+
+struct BlockResult {
+  double worst_J = 0, worst_sigma = 0, force_error = 0, energy_ratio = 0;
+  int retries = 0;  // steps redone as two half steps, as the app's step controller does
+  bool converged = true;
+  std::string failure;
+};
+
+// Block [0.5, 1.5] mm^2 on a 2 mm grid (h = 0.1 mm, 2x2 points per cell), top wall down at
+// V = 0.4 m/s to s = s_end in `steps` steps (theta = 1).
+BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall_points,
+                    double s_end, int steps) {
+  constexpr double mu = 1.5e6, rho = 990.0, h = 1e-4, lo = 5e-4, hi = 1.5e-3, V = 0.4;
+  auto model = test_support::make_model(h, 20, 20, "neo_hookean", lambda, mu, rho);
+  test_support::add_box(model, Vec<2>(lo, lo), Vec<2>(hi, hi), 2,
+                        [&](const Vec<2>& x) { return Vec<2>(0.0, -V * (x[1] - lo) / (hi - lo)); });
+  mpm::Settings<2> s;
+  s.shape = shape;
+  s.affine = affine;
+  s.theta = 1.0;
+  s.residual_tolerance = s.increment_tolerance = 1e-12;
+  s.contact.enabled = true;
+  s.contact.wall_points = wall_points;
+  s.contact.gs.tolerance = 1e-12;
+  s.contact.impulse_tolerance = 1e-12;
+  s.contact.walls = {{"bottom", Vec<2>(0, lo), Vec<2>(0, 1), Vec<2>::Zero(), 0.0},
+                     {"top", Vec<2>(0, hi), Vec<2>(0, -1), Vec<2>(0, -V), 0.0},
+                     {"left", Vec<2>(lo, 0), Vec<2>(1, 0), Vec<2>::Zero(), 0.0},
+                     {"right", Vec<2>(hi, 0), Vec<2>(-1, 0), Vec<2>::Zero(), 0.0}};
+  mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
+  const double H0 = hi - lo, dt = (1.0 - s_end) * H0 / V / steps;
+  const auto d0 = mpm::diagnostics(model);
+  BlockResult r;
+  double work = 0, t = 0, force = 0;
+  // One step of size `step`; a failed step is redone as two half steps (up to 1/16), as the
+  // app's controller cuts dt (docs/accuracy.md lists the failures this still meets).
+  std::function<bool(double, int)> advance = [&](double step, int depth) {
+    solver.set_time(t);
+    const auto st = solver.solve_step(step);
+    if (!st.converged) {
+      if (depth == 4) {
+        r.failure = st.failure + " at t = " + std::to_string(t);
+        return false;
+      }
+      ++r.retries;
+      return advance(step / 2, depth + 1) && advance(step / 2, depth + 1);
+    }
+    solver.commit();
+    t += step;
+    force = st.wall_force[1][1];  // force of the grain on the top wall (+y) [N/m]
+    work += force * V * step;     // the wall moves down at V against it
+    return true;
+  };
+  for (int k = 0; k < steps; ++k)
+    if (!advance(dt, 0)) {
+      r.converged = false;
+      return r;
+    }
+  const double sf = 1.0 - V * t / H0;
+  const double s22 = (mu * (sf * sf - 1) + lambda * std::log(sf)) / sf;
+  for (std::size_t p = 0; p < model.points.size(); ++p) {
+    r.worst_J = std::max(r.worst_J, std::abs(model.points.F[p].determinant() - sf));
+    r.worst_sigma =
+        std::max(r.worst_sigma, std::abs(model.points.sigma[p](1, 1) - s22) / std::abs(s22));
+  }
+  r.force_error = std::abs(force - (-s22 * H0)) / std::abs(s22 * H0);
+  const auto d = mpm::diagnostics(model);
+  r.energy_ratio = (d.elastic + d.kinetic - d0.elastic - d0.kinetic) / work;
+  std::printf(
+      "  lambda %.3g MPa, s = %.3f: max |J - s| = %.2e, max rel. sigma22 error = %.2e, "
+      "top force error = %.2e, (elastic + kinetic change) / wall work = %.5f, %d steps "
+      "redone as half steps\n",
+      lambda / 1e6, sf, r.worst_J, r.worst_sigma, r.force_error, r.energy_ratio, r.retries);
+  return r;
+}
+
+}  // namespace
+
+TEST(WallBlock, CpdiAffineFaceWallsKeepTheExactState) {
+  // lambda = 3 MPa is exact too but meets a NaN Newton iterate near s = 0.75 that half steps do
+  // not cure in this driver (the app recovers from it with its dt cuts): to s = 0.8 here.
+  for (const auto& [lambda, s_end, steps] :
+       {std::tuple{0.0, 0.5, 333}, std::tuple{3e6, 0.8, 133}}) {
+    const auto r = squeeze(lambda, grid::ShapeKind::kCpdi, true, true, s_end, steps);
+    ASSERT_TRUE(r.converged) << r.failure;
+    EXPECT_LT(r.worst_J, 1e-6);
+    EXPECT_LT(r.worst_sigma, 1e-6);
+    EXPECT_LT(r.force_error, 1e-6);
+    // Backward Euler stores less than the wall work by about F dd / 2 per step: 0.4-0.8 % here.
+    EXPECT_GT(r.energy_ratio, 0.99);
+    EXPECT_LE(r.energy_ratio, 1.0 + 1e-9);
+  }
+}
+
+TEST(WallBlock, EachIngredientIsNeeded) {
+  // Without any one of the three parts the exact state is lost within s = 0.8 (docs/accuracy.md).
+  const auto nodes = squeeze(3e6, grid::ShapeKind::kCpdi, true, false, 0.8, 60);
+  const auto linear = squeeze(3e6, grid::ShapeKind::kLinear, true, true, 0.8, 60);
+  const auto plain = squeeze(3e6, grid::ShapeKind::kCpdi, false, true, 0.8, 60);
+  EXPECT_GT(nodes.worst_sigma, 1e-2);
+  EXPECT_GT(linear.worst_sigma, 1e-2);
+  EXPECT_GT(plain.worst_sigma, 1e-5);
+}
