@@ -631,9 +631,37 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                     parallel::kWorkPhases, 0.0);
     solver.set_grain_work(std::move(work));
   }
+  // Energy ledger (docs/accuracy.md): the work done by each wall on the grains, W_k += -F_k . v_k
+  // dt with F_k the grains' force on wall k over the step, against the change of elastic plus
+  // kinetic energy since t = 0; the remainder is what contact and the integrator dissipated.
+  std::vector<double> wall_work(cfg.walls.size(), 0.0);
+  double energy0 = 0;
+  if (restart) {
+    wall_work = restart->wall_work;
+    energy0 = restart->energy0;
+  } else {
+    const auto d0 = mpm::diagnostics(model);  // every rank holds the initial points
+    energy0 = d0.elastic + d0.kinetic;
+  }
+  std::string ledger_header;
+  for (const auto& w : cfg.walls) ledger_header += ",wall_" + w.name + "_work";
+  if (!cfg.walls.empty()) ledger_header += ",energy_change,energy_unaccounted";
   std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
   if (root)
-    out_ptr = std::make_unique<Outputs>(cfg, summary.output_dir, observer.csv_header(), restart);
+    out_ptr = std::make_unique<Outputs>(cfg, summary.output_dir,
+                                        observer.csv_header() + ledger_header, restart);
+  // The ledger's CSV fields: work of each wall, E - E0, and E - E0 - sum of the walls' work.
+  const auto ledger_fields = [&](const mpm::Diagnostics<2>& d) {
+    std::string f;
+    if (wall_work.empty()) return f;  // the ledger is written by runs with walls
+    double total = 0;
+    for (const double w : wall_work) {
+      f += fmt::format(",{:.12e}", w);
+      total += w;
+    }
+    const double change = d.elastic + d.kinetic - energy0;
+    return f + fmt::format(",{:.12e},{:.12e}", change, change - total);
+  };
   const bool stop_active = cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0;
   const auto gather_state = [&](int to) {
     ScopedStage ts(&solver.timers(), "output");
@@ -677,9 +705,11 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     ScopedStage ts(&solver.timers(), "output");
     const auto problem = parallel::gather_contacts(comm, solver.contact_problem(), 0);
     if (csv) {
-      if (root)
-        out_ptr->csv_row(summary.steps, t, dt, last, mpm::diagnostics(model),
-                         observer.csv_fields(model, last, problem, t));
+      if (root) {
+        const auto d = mpm::diagnostics(model);
+        out_ptr->csv_row(summary.steps, t, dt, last, d,
+                         observer.csv_fields(model, last, problem, t) + ledger_fields(d));
+      }
       next_csv = t + cfg.output.csv_interval;
     }
     if (vtu) {
@@ -766,6 +796,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     if (comm.size() > 1)
       for (std::size_t g = 0; g < model.grains.size(); ++g) s.grain_owner[g] = solver.owner()[g];
     s.grain_work = work;
+    s.wall_work = wall_work;
+    s.energy0 = energy0;
     const std::string path =
         (fs::path(out.dir()) / checkpoint::file_name(cfg.simulation.name, s.step)).string();
     checkpoint::write(s, path);
@@ -814,6 +846,10 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     }
     solver.commit();
     last = st;
+    for (std::size_t k = 0; k < wall_work.size() && k < st.wall_force.size(); ++k)
+      wall_work[k] -= (st.wall_force[k][0] * settings.contact.walls[k].velocity[0] +
+                       st.wall_force[k][1] * settings.contact.walls[k].velocity[1]) *
+                      dt_try;
     if (comm.size() > 1 && scheme == parallel::Scheme::kPartition && opt.rebalance > 0 &&
         (summary.steps + 1) % 50 == 0) {  // docs/parallel.md: deterministic work weights
       ScopedStage ts(&solver.timers(), "rebalance");
@@ -917,6 +953,18 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                summary.signal != 0 ? signal_name(summary.signal) : "--stop-after", summary.steps,
                t);
     return summary;
+  }
+  if (!wall_work.empty() && comm.size() > 1) gather_state(0);  // collective
+  if (!wall_work.empty() && root) {  // the energy balance of the run (docs/accuracy.md)
+    const auto d = mpm::diagnostics(model);
+    double total = 0;
+    for (const double w : wall_work) total += w;
+    const double change = d.elastic + d.kinetic - energy0;
+    log().info(
+        "energy: walls did {:.6g} J/m of work, elastic + kinetic changed by {:.6g} J/m; "
+        "unaccounted (contact and integrator dissipation) {:.6g} J/m = {:.3g} % of the "
+        "work",
+        total, change, total - change, total != 0 ? 100 * (total - change) / std::abs(total) : 0.0);
   }
   log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,
              summary.failed_steps, t, summary.wall_seconds, timers);

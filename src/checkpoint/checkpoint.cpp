@@ -266,10 +266,10 @@ std::uint64_t payload_checksum(const State& s) {
   for (auto v : {s.dim}) h = hash_value(v, h);
   for (auto v : {s.step, s.good_since_cut, s.failed_steps, s.newton_iterations, s.csv_rows})
     h = hash_value(v, h);
-  for (auto v : {s.time, s.dt, s.next_vtu, s.next_csv}) h = hash_value(v, h);
-  for (const auto* a :
-       {&s.vtu_times, &s.x, &s.v, &s.L, &s.F, &s.sigma, &s.domain, &s.sigma_zz, &s.mass, &s.volume0,
-        &s.volume, &s.history, &s.grain_half_width, &s.warm_impulse, &s.wall_point, &s.grain_work})
+  for (auto v : {s.time, s.dt, s.next_vtu, s.next_csv, s.energy0}) h = hash_value(v, h);
+  for (const auto* a : {&s.vtu_times, &s.x, &s.v, &s.L, &s.F, &s.sigma, &s.domain, &s.sigma_zz,
+                        &s.mass, &s.volume0, &s.volume, &s.history, &s.grain_half_width,
+                        &s.warm_impulse, &s.wall_point, &s.grain_work, &s.wall_work})
     h = hash_array(*a, h);
   for (const auto* a : {&s.grain, &s.grain_material, &s.warm_a, &s.warm_b, &s.grain_owner})
     h = hash_array(*a, h);
@@ -336,6 +336,8 @@ void write(const State& s, const std::string& path) {
     w.array("/contact/warm_impulse", s.warm_impulse, {nw, d});
     w.group("/walls");
     w.array("/walls/point", s.wall_point, {s.wall_point.size() / std::max<hsize_t>(d, 1), d});
+    w.array("/walls/work", s.wall_work, {s.wall_work.size()});
+    w.scalar("/time/energy0", s.energy0);
     w.group("/parallel");
     w.scalar("/parallel/ranks", s.ranks);
     w.text("/parallel/scheme", s.scheme);
@@ -455,6 +457,8 @@ State read(const std::string& path) {
   s.warm_b = r.array<std::int32_t>("/contact/warm_b", {nw});
   s.warm_impulse = r.array<double>("/contact/warm_impulse", {nw, d});
   s.wall_point = r.array<double>("/walls/point", {any, d});
+  s.wall_work = r.array<double>("/walls/work", {s.wall_point.size() / d});
+  s.energy0 = r.scalar<double>("/time/energy0");
   s.ranks = r.scalar<std::int32_t>("/parallel/ranks");
   s.scheme = r.text("/parallel/scheme");
   s.grain_owner = r.array<std::int32_t>("/parallel/grain_owner", {ng});

@@ -68,6 +68,8 @@ struct State {
   std::vector<double> warm_impulse;     ///< impulse on b, count x dim [N s] (2D: N s/m)
   // Walls (their position is point + velocity t; stored to check and inspect).
   std::vector<double> wall_point;  ///< current point of each wall plane, walls x dim [m]
+  std::vector<double> wall_work;   ///< work done by each wall on the grains so far [J] (2D: J/m)
+  double energy0 = 0;              ///< elastic + kinetic energy at t = 0 [J] (2D: J/m)
   // Distribution (docs/parallel.md): restored when the rank count and scheme are the same.
   std::int32_t ranks = 1;                 ///< MPI ranks of the writing run [-]
   std::string scheme = "partition";       ///< parallel scheme of the writing run [-]

@@ -73,6 +73,8 @@ ck::State sample() {
   s.warm_b = {1};
   s.warm_impulse = {1e-9, -3e-7};
   s.wall_point = {0.0, 1.2e-3};
+  s.wall_work = {-3.25e-4};
+  s.energy0 = 1.5e-5;
   s.ranks = 2;
   s.scheme = "partition";
   s.grain_owner = {1, 0};
@@ -164,6 +166,8 @@ TEST(Checkpoint, RoundTripIsBitwise) {
   EXPECT_TRUE(same(r.history, s.history));  // denormal and -0.0 survive
   EXPECT_TRUE(same(r.warm_impulse, s.warm_impulse));
   EXPECT_TRUE(same(r.wall_point, s.wall_point));
+  EXPECT_TRUE(same(r.wall_work, s.wall_work));
+  EXPECT_EQ(r.energy0, s.energy0);
   EXPECT_EQ(r.grain, s.grain);
   EXPECT_EQ(r.grain_begin, s.grain_begin);
   EXPECT_EQ(r.grain_end, s.grain_end);
