@@ -1198,7 +1198,6 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         for (std::size_t f0 = 0; f0 < faces.size();) {
           std::size_t f1 = f0;
           std::vector<std::int64_t> pts;
-          double dsum = 0;
           while (f1 < faces.size() && faces[f1].column == faces[f0].column) {
             if (faces[f1].dist <= faces[f0].dist + 0.5 * faces[f0].ext) pts.push_back(faces[f1].p);
             ++f1;
@@ -1206,7 +1205,6 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
           f0 = f1;
           Vec<Dim> x_face;
           const std::int32_t sb = face_slot(static_cast<std::int32_t>(g), pts, wall.normal, x_face);
-          (void)dsum;
           if (sb < 0) continue;
           // Warm-start key of a face contact: -1 - the grid cell of the mean face centre projected
           // on the wall's plane through the origin (the column: stable while the faces move
