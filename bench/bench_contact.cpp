@@ -2,7 +2,9 @@
 // diameters uniform in [0.8, 1.2] mm, ~8 cells per mean diameter, 2x2 points per cell, four walls,
 // the top one moving down at 2 m/s, dt = 0.1 us): time of contact detection per step, of one
 // Gauss-Seidel sweep per contact, and the share of the step spent in contact, for the grain
-// compliance (LDLT) and the lumped (CG) Delassus operators, 1 and 2 threads; and one Gauss-Seidel
+// compliance (LDLT) and the lumped (CG) Delassus operators, 1 and 2 threads, and the compliance
+// with modified Newton (Settings::modified_newton, "modified" = 1), also with CPDI shape functions
+// and affine P2G ("cpdi_affine" = 1); and one Gauss-Seidel
 // solve of a synthetic lumped problem on 1 and 2 threads (BM_GaussSeidelNodes).
 //   ./build/release/bench/bench_contact --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
@@ -24,6 +26,11 @@ void BM_ContactPacking(benchmark::State& state) {
   mpm::Settings<2> s;
   s.theta = 1.0;
   s.linear_solver = kind;
+  s.modified_newton = state.range(2) != 0;
+  if (state.range(3) != 0) {  // the large-deformation options (docs/accuracy.md)
+    s.shape = grid::ShapeKind::kCpdi;
+    s.affine = true;
+  }
   s.contact.enabled = true;
   s.contact.walls = setup.walls;
   mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
@@ -92,8 +99,9 @@ BENCHMARK(BM_GaussSeidelNodes)
     ->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ContactPacking)
-    ->ArgNames({"solver", "threads"})
-    ->ArgsProduct({{0, 2}, {1, 2}})
+    ->ArgNames({"solver", "threads", "modified", "cpdi_affine"})
+    ->ArgsProduct({{0, 2}, {1, 2}, {0}, {0}})
+    ->ArgsProduct({{0}, {1, 2}, {1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(5.0);

@@ -1,7 +1,8 @@
 // Material-point updates per second of the implicit MPM step (no contact): P2G, G2P and the whole
 // step (P2G + Newton + G2P), for ~200-point Neo-Hookean disks like the paper's compaction grains
 // (R = 0.5 mm, h = R/4, 2x2 points per cell, dt = 0.1 us), at 10k and 100k points, 1 and 2 threads,
-// with the sparse direct (LDLT) and the Jacobi-CG per-grain solvers.
+// with the sparse direct (LDLT) and the Jacobi-CG per-grain solvers; "accurate" = 1 runs the
+// large-deformation options (CPDI shape functions, affine P2G, modified Newton: docs/accuracy.md).
 //   ./build/release/bench/bench_mpm --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -51,6 +52,11 @@ void BM_ImplicitStep(benchmark::State& state) {
   mpm::Settings<2> s;
   s.theta = 1.0;
   s.linear_solver = solver_kind;
+  if (state.range(3) != 0) {
+    s.shape = grid::ShapeKind::kCpdi;
+    s.affine = true;
+    s.modified_newton = true;
+  }
   mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
   const double np = static_cast<double>(model.points.size());
   std::int64_t iterations = 0, steps = 0;
@@ -75,8 +81,9 @@ void BM_ImplicitStep(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_ImplicitStep)
-    ->ArgNames({"points", "threads", "solver"})
-    ->ArgsProduct({{10000, 100000}, {1, 2}, {0, 2}})
+    ->ArgNames({"points", "threads", "solver", "accurate"})
+    ->ArgsProduct({{10000, 100000}, {1, 2}, {0, 2}, {0}})
+    ->ArgsProduct({{10000, 100000}, {1, 2}, {0}, {1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -204,6 +204,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
   s.cg_max_iterations = cfg.solver.cg_max_iterations;
   s.flip = cfg.solver.flip;
   s.affine = cfg.solver.affine;
+  s.modified_newton = cfg.solver.modified_newton;
   if (cfg.loads.gravity.size() == 2) s.gravity = vec2(cfg.loads.gravity);
   // Contact: enabled when asked and there is something to touch (two grains or a wall).
   auto& c = s.contact;

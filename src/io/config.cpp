@@ -290,7 +290,12 @@ Schema build_schema() {
                          "affine P2G: each point carries its velocity gradient L and gives its "
                          "nodes m N (v + L (x_I - x_p)) (APIC/TPIC), so that linear velocity "
                          "fields cross the grid exactly")
-            .defaults(boolean_text(d.solver.affine))},
+            .defaults(boolean_text(d.solver.affine)),
+        KeySpec::boolean("modified_newton",
+                         "modified Newton: factorise the Newton matrix once per step and reuse it "
+                         "(and the contact compliance) in later iterations, refactorising when the "
+                         "residual stalls; same converged answer, fewer factorisations")
+            .defaults(boolean_text(d.solver.modified_newton))},
        ""});
 
   s.tables.push_back(
@@ -743,6 +748,7 @@ class ConfigReader {
     r.read("cg_max_iterations", s.cg_max_iterations);
     r.read("flip", s.flip);
     r.read("affine", s.affine);
+    r.read("modified_newton", s.modified_newton);
   }
 
   void read_contact(const TableReader& root, Config& c) {

@@ -53,6 +53,9 @@ struct ImplicitSolver<Dim>::GrainWork {
   Eigen::MatrixXd Z;                // A^-1 E: response of all dofs to unit slot impulses [s/kg]
   bool z_forward = false;           // Z holds Y = L^-1 P E instead (LDL^T: grain_compliance)
   bool tangent_current = false, factor_current = false;  // K_blk / factorisation match v
+  bool factor_in_step = false;     // a factorisation of this step's Newton matrix exists
+  std::int64_t factor_count = 0;   // factorisations so far (identifies the current one)
+  std::int64_t z_factor = -1;      // the factorisation Z and G were computed with (-1: none)
   double vel_ref = 0;                     // velocity scale of the increment test [sqrt(kg) m/s]
   bool evaluated = false;                 // residual evaluated in the current Newton iteration
   std::vector<IVec<Dim>> pt_first;        // per point: first support node (box coordinates)
@@ -61,8 +64,7 @@ struct ImplicitSolver<Dim>::GrainWork {
   std::vector<Vec<Dim>> pt_dN;            // per point x K: gradients at x^n [1/m]
   int K = 0, S = 0, radius = 0;           // support size, stencil size, stencil radius
   std::vector<std::int32_t> pair_slot;    // K x K: stencil slot of node b seen from node a
-  std::vector<std::int32_t> stencil_nb;   // active x S: coupled neighbour active node or -1
-  std::vector<std::uint8_t> coupled, prev_coupled;  // active x S: the pair shares a point
+  std::vector<std::int32_t> stencil_nb;   // active x S: neighbour active node or -1
   std::vector<Mat<Dim>> K_blk;            // active x S: tangent blocks K_ab [N/m]
   SpMat A;                                // Newton matrix M + theta^2 dt^2 K
   std::vector<std::int64_t> value_index;  // (active x S x Dim x Dim) -> A.valuePtr() index
@@ -73,7 +75,7 @@ struct ImplicitSolver<Dim>::GrainWork {
   // Newton bookkeeping.
   bool converged = false, solved_once = false;
   int iterations = 0;
-  std::int64_t solves = 0;
+  std::int64_t solves = 0, factorizations = 0;  // in the current step
   double cg_work = 0;  // CG iterations x matrix non-zeros of the last solve [-]
   double res_norm = 0, res_ref = 0, dv_norm = 0;
   std::vector<double> history;  // |R| / reference per iteration
@@ -149,10 +151,13 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   w.solved_once = false;
   w.iterations = 0;
   w.solves = 0;
+  w.factorizations = 0;
   w.failure.clear();
   w.retryable = true;
   w.fail_point = -1;
   w.history.clear();
+  w.factor_in_step = false;
+  w.z_factor = -1;
   w.pt_first.resize(np);
   w.pt_N.resize(np * K);
   w.pt_dN.resize(np * K);
@@ -318,51 +323,37 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   reset(w.R, na, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.du, na, Vec<Dim>(Vec<Dim>::Zero()));
   (void)dt;
-  // Stencil geometry of the tangent (depends on the shape family only): node b couples to node a
-  // if |c_b - c_a| <= radius per axis; pair_slot maps a support pair to its stencil slot.
-  const int width = 2 * (S1::kNodes - 1) + 1;
-  if (w.S == 0) {
-    w.radius = S1::kNodes - 1;
-    w.S = 1;
-    for (int d = 0; d < Dim; ++d) w.S *= width;
-    w.pair_slot.resize(K * K);
-    for (int a = 0; a < K; ++a)
-      for (int b = 0; b < K; ++b) {
-        int slot = 0, mul = 1;
-        for (int d = 0; d < Dim; ++d) {
-          slot += (Shape::offset(b, d) - Shape::offset(a, d) + w.radius) * mul;
-          mul *= width;
-        }
-        w.pair_slot[a * K + b] = slot;
-      }
-  }
-  // Couplings present at this step: nodes a and b share a point with non-zero weight or gradient
-  // at both. Only these enter the sparse pattern (a CPDI window spans 3 nodes per axis, so the
-  // stencil has radius 2, but most pairs in it share no point: docs/accuracy.md, cost).
-  reset(w.coupled, na * w.S, std::uint8_t{0});
-  for (std::int64_t i = 0; i < np; ++i)
-    for (int a = 0; a < K; ++a) {
-      const std::int32_t n = w.pt_node[i * K + a];
-      if (n < 0) continue;
-      for (int b = 0; b < K; ++b)
-        if (w.pt_node[i * K + b] >= 0) w.coupled[n * w.S + w.pair_slot[a * K + b]] = 1;
-    }
   // The pattern (stencil, sparse structure, symbolic factorisation) depends only on the active
-  // node set and the couplings: reuse it when both are unchanged (the usual case at small dt).
-  if (same_box && w.box_to_active == w.prev_box_to_active && w.coupled == w.prev_coupled) return;
-  w.prev_coupled = w.coupled;
+  // node set: reuse it when unchanged (the usual case at small dt).
+  if (same_box && w.box_to_active == w.prev_box_to_active) return;
   w.pattern_valid = true;
+  // Stencil of the tangent: node b couples to node a if |c_b - c_a| <= radius per axis.
+  w.radius = S1::kNodes - 1;
+  const int width = 2 * w.radius + 1;
+  w.S = 1;
+  for (int d = 0; d < Dim; ++d) w.S *= width;
+  w.pair_slot.resize(K * K);
+  for (int a = 0; a < K; ++a)
+    for (int b = 0; b < K; ++b) {
+      int slot = 0, mul = 1;
+      for (int d = 0; d < Dim; ++d) {
+        slot += (Shape::offset(b, d) - Shape::offset(a, d) + w.radius) * mul;
+        mul *= width;
+      }
+      w.pair_slot[a * K + b] = slot;
+    }
   w.stencil_nb.assign(na * w.S, -1);
   for (std::size_t a = 0; a < na; ++a)
     for (int s = 0; s < w.S; ++s) {
-      if (!w.coupled[a * w.S + s]) continue;
       IVec<Dim> c = w.node_box[a];
       int r = s;
+      bool inside = true;
       for (int d = 0; d < Dim; ++d) {
         c[d] += r % width - w.radius;
         r /= width;
+        if (c[d] < 0 || c[d] >= w.box_n[d]) inside = false;
       }
-      w.stencil_nb[a * w.S + s] = w.box_to_active[c.dot(stride)];
+      if (inside) w.stencil_nb[a * w.S + s] = w.box_to_active[c.dot(stride)];
     }
   w.K_blk.resize(na * w.S);
   // Sparse pattern of the Newton matrix and the map from stencil blocks to stored values.
@@ -588,6 +579,9 @@ bool ImplicitSolver<Dim>::factorize_grain(std::size_t g, double dt) {
   }
   if (!ok) w.failure = "linear solve failed (singular or indefinite tangent)";
   w.factor_current = ok;
+  w.factor_in_step = ok;
+  ++w.factor_count;
+  ++w.factorizations;
   return ok;
 }
 
@@ -610,10 +604,20 @@ Eigen::VectorXd ImplicitSolver<Dim>::linear_solve(std::size_t g, const Rhs& rhs)
 }
 
 template <int Dim>
-void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt) {
+bool ImplicitSolver<Dim>::reuse_factor(const GrainWork& w) const {
+  // Modified Newton (Settings::modified_newton): the step's first factorisation serves all its
+  // iterations and contact updates, unless the residual stalls (falls by less than half over an
+  // iteration), when the tangent is rebuilt.
+  if (!settings_.modified_newton || !w.factor_in_step) return false;
+  const auto n = w.history.size();
+  return n < 2 || w.history[n - 1] < 0.5 * w.history[n - 2];
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt, bool reuse) {
   GrainWork& w = *work_[g];
   const std::size_t na = w.m.size();
-  if (!factorize_grain(g, dt)) return;
+  if (!reuse && !factorize_grain(g, dt)) return;
   w.rhs.resize(static_cast<Eigen::Index>(na * Dim));
   for (std::size_t a = 0; a < na; ++a)
     for (int d = 0; d < Dim; ++d) w.rhs[a * Dim + d] = -w.R[a][d];
@@ -807,10 +811,11 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         const std::size_t g = owned_[i];
         GrainWork& w = *work_[g];
         if (w.converged || !w.failure.empty()) continue;
-        if (!w.tangent_current) {
+        const bool reuse = reuse_factor(w);
+        if (!reuse && !w.tangent_current) {
           with_shape(settings_.shape, [&](auto tag) { assemble_tangent<decltype(tag)>(g); });
         }
-        solve_grain(g, dt);
+        solve_grain(g, dt, reuse);
         const double u = kCgWorkWeight * w.cg_work;
         phase_work(g, it) += u;
         units += u;
@@ -826,6 +831,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   for (std::size_t g : owned_) {
     stats.iterations = std::max(stats.iterations, work_[g]->iterations);
     stats.linear_solves += work_[g]->solves;
+    stats.factorizations += work_[g]->factorizations;
   }
   if (!stats.converged) {
     for (std::size_t g : owned_)
@@ -863,13 +869,15 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   }
   if (dist) {  // sums over the ranks' contacts, added in rank order
     ScopedStage tc(&timers_, "newton.check.comm");
-    std::vector<std::int64_t> n{stats.contacts, stats.active_contacts, stats.linear_solves};
+    std::vector<std::int64_t> n{stats.contacts, stats.active_contacts, stats.linear_solves,
+                                stats.factorizations};
     comm_->sum(n);
     std::vector<std::int64_t> it{-stats.iterations};
     comm_->min(it);
     stats.contacts = n[0];
     stats.active_contacts = n[1];
     stats.linear_solves = n[2];
+    stats.factorizations = n[3];
     stats.iterations = static_cast<int>(-it[0]);
     std::vector<double> f;
     for (const auto& wf : stats.wall_force) f.insert(f.end(), wf.begin(), wf.end());
@@ -1341,10 +1349,15 @@ void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   // matrix. Column (j, d) of E is sum_k w_jk e_{a_jk, d} (one node of weight 1 for a node slot).
   GrainWork& w = *work_[g];
   if (!w.lumped_group) {
-    if (!w.tangent_current) {
-      with_shape(settings_.shape, [&](auto tag) { assemble_tangent<decltype(tag)>(g); });
+    if (!reuse_factor(w)) {
+      if (!w.tangent_current) {
+        with_shape(settings_.shape, [&](auto tag) { assemble_tangent<decltype(tag)>(g); });
+      }
+      if (!w.factor_current && !factorize_grain(g, dt_)) return;
     }
-    if (!w.factor_current && !factorize_grain(g, dt_)) return;
+    // Z and G depend only on the factorisation and the slots (fixed within a step).
+    if (w.z_factor == w.factor_count) return;
+    w.z_factor = w.factor_count;
   }
   const auto k = static_cast<Eigen::Index>(w.slots.size());
   const auto ndof = static_cast<Eigen::Index>(w.m.size() * Dim);

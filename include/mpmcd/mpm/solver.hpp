@@ -91,6 +91,10 @@ struct Settings {
   /// TPIC, Nakamura et al. 2023): m_I v_I = sum N m_p (v_p + L_p (x_I - x_p)), L_p carried by the
   /// points, so that a linear velocity field is transferred exactly whatever the positions.
   bool affine = false;
+  /// Modified Newton: factorise the Newton matrix once per step and reuse it (and the contact
+  /// compliance computed from it) in the later iterations; refactorised when the residual
+  /// stalls. Same converged answer, fewer factorisations (docs/accuracy.md, cost).
+  bool modified_newton = false;
   Vec<Dim> gravity = Vec<Dim>::Zero();  ///< body acceleration [m/s^2]
   ContactSettings<Dim> contact;         ///< contact between grains and with walls
 };
@@ -112,6 +116,7 @@ struct StepStats {
   bool converged = false;                ///< all grains converged
   int iterations = 0;                    ///< Newton iterations (max over grains)
   std::int64_t linear_solves = 0;        ///< linear solves, summed over grains
+  std::int64_t factorizations = 0;       ///< Newton-matrix factorisations, summed over grains
   std::vector<double> residual_history;  ///< per iteration: max over grains of |R| / reference
   std::string failure;                   ///< why the step failed ("" if converged)
   bool retryable = true;             ///< false if a smaller dt cannot help (a point left the grid)
@@ -206,7 +211,9 @@ class ImplicitSolver {
   bool factorize_grain(std::size_t g, double dt);
   template <class Rhs>
   Eigen::VectorXd linear_solve(std::size_t g, const Rhs& rhs);
-  void solve_grain(std::size_t g, double dt);
+  void solve_grain(std::size_t g, double dt, bool reuse);
+  /// True if grain work w solves with its existing factorisation (Settings::modified_newton).
+  bool reuse_factor(const GrainWork& w) const;
   void grain_compliance(std::size_t g);
   void detect_contacts(double dt);
   double update_contacts(StepStats& stats);
