@@ -634,24 +634,28 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   }
   // Energy ledger (docs/accuracy.md): the work done by each wall on the grains, W_k += -F_k . v_k
   // dt with F_k the grains' force on wall k over the step, against the change of elastic plus
-  // kinetic energy since t = 0; the remainder is what contact and the integrator dissipated.
+  // kinetic energy since t = 0. Contact dissipates D += sum_k W_k(step) - W_c(step), W_c the work
+  // of all contact impulses on the grains (StepStats::contact_work); the remainder is the time
+  // integrator's and the transfers' (P2G/G2P).
   std::vector<double> wall_work(cfg.walls.size(), 0.0);
-  double energy0 = 0;
+  double energy0 = 0, contact_dissipation = 0;
   if (restart) {
     wall_work = restart->wall_work;
     energy0 = restart->energy0;
+    contact_dissipation = restart->contact_dissipation;
   } else {
     const auto d0 = mpm::diagnostics(model);  // every rank holds the initial points
     energy0 = d0.elastic + d0.kinetic;
   }
   std::string ledger_header;
   for (const auto& w : cfg.walls) ledger_header += ",wall_" + w.name + "_work";
-  if (!cfg.walls.empty()) ledger_header += ",energy_change,energy_unaccounted";
+  if (!cfg.walls.empty()) ledger_header += ",energy_change,contact_dissipation,energy_unaccounted";
   std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
   if (root)
     out_ptr = std::make_unique<Outputs>(cfg, summary.output_dir,
                                         observer.csv_header() + ledger_header, restart);
-  // The ledger's CSV fields: work of each wall, E - E0, and E - E0 - sum of the walls' work.
+  // The ledger's CSV fields: work of each wall, E - E0, the contact dissipation D, and the
+  // remainder E - E0 - sum of the walls' work + D.
   const auto ledger_fields = [&](const mpm::Diagnostics<2>& d) {
     std::string f;
     if (wall_work.empty()) return f;  // the ledger is written by runs with walls
@@ -661,7 +665,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
       total += w;
     }
     const double change = d.elastic + d.kinetic - energy0;
-    return f + fmt::format(",{:.12e},{:.12e}", change, change - total);
+    return f + fmt::format(",{:.12e},{:.12e},{:.12e}", change, contact_dissipation,
+                           change - total + contact_dissipation);
   };
   const bool stop_active = cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0;
   const auto gather_state = [&](int to) {
@@ -799,6 +804,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     s.grain_work = work;
     s.wall_work = wall_work;
     s.energy0 = energy0;
+    s.contact_dissipation = contact_dissipation;
     const std::string path =
         (fs::path(out.dir()) / checkpoint::file_name(cfg.simulation.name, s.step)).string();
     checkpoint::write(s, path);
@@ -847,10 +853,15 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     }
     solver.commit();
     last = st;
-    for (std::size_t k = 0; k < wall_work.size() && k < st.wall_force.size(); ++k)
-      wall_work[k] -= (st.wall_force[k][0] * settings.contact.walls[k].velocity[0] +
-                       st.wall_force[k][1] * settings.contact.walls[k].velocity[1]) *
-                      dt_try;
+    double step_work = 0;
+    for (std::size_t k = 0; k < wall_work.size() && k < st.wall_force.size(); ++k) {
+      const double wk = -(st.wall_force[k][0] * settings.contact.walls[k].velocity[0] +
+                          st.wall_force[k][1] * settings.contact.walls[k].velocity[1]) *
+                        dt_try;
+      wall_work[k] += wk;
+      step_work += wk;
+    }
+    if (!wall_work.empty()) contact_dissipation += step_work - st.contact_work;
     if (comm.size() > 1 && scheme == parallel::Scheme::kPartition && opt.rebalance > 0 &&
         (summary.steps + 1) % 50 == 0) {  // docs/parallel.md: deterministic work weights
       ScopedStage ts(&solver.timers(), "rebalance");
@@ -961,11 +972,13 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     double total = 0;
     for (const double w : wall_work) total += w;
     const double change = d.elastic + d.kinetic - energy0;
+    const double rest = total - change - contact_dissipation;
+    const auto pct = [&](double x) { return total != 0 ? 100 * x / std::abs(total) : 0.0; };
     log().info(
-        "energy: walls did {:.6g} J/m of work, elastic + kinetic changed by {:.6g} J/m; "
-        "unaccounted (contact and integrator dissipation) {:.6g} J/m = {:.3g} % of the "
-        "work",
-        total, change, total - change, total != 0 ? 100 * (total - change) / std::abs(total) : 0.0);
+        "energy: walls did {:.6g} J/m of work, elastic + kinetic changed by {:.6g} J/m, contact "
+        "dissipated {:.6g} J/m ({:.3g} %); unaccounted (time integrator and transfers) {:.6g} "
+        "J/m = {:.3g} % of the work",
+        total, change, contact_dissipation, pct(contact_dissipation), rest, pct(rest));
   }
   log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,
              summary.failed_steps, t, summary.wall_seconds, timers);

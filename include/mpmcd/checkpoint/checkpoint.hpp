@@ -12,7 +12,7 @@
 namespace mpmcd::checkpoint {
 
 /// Layout version of the files this build writes and reads [-].
-inline constexpr std::int32_t kFormatVersion = 4;
+inline constexpr std::int32_t kFormatVersion = 5;
 
 /// FNV-1a 64-bit offset basis (start value of fnv1a) [-].
 inline constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
@@ -70,6 +70,7 @@ struct State {
   std::vector<double> wall_point;  ///< current point of each wall plane, walls x dim [m]
   std::vector<double> wall_work;   ///< work done by each wall on the grains so far [J] (2D: J/m)
   double energy0 = 0;              ///< elastic + kinetic energy at t = 0 [J] (2D: J/m)
+  double contact_dissipation = 0;  ///< energy dissipated by contact since t = 0 [J] (2D: J/m)
   // Distribution (docs/parallel.md): restored when the rank count and scheme are the same.
   std::int32_t ranks = 1;                 ///< MPI ranks of the writing run [-]
   std::string scheme = "partition";       ///< parallel scheme of the writing run [-]

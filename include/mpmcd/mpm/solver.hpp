@@ -117,6 +117,9 @@ struct StepStats {
   int iterations = 0;                    ///< Newton iterations (max over grains)
   std::int64_t linear_solves = 0;        ///< linear solves, summed over grains
   std::int64_t factorizations = 0;       ///< Newton-matrix factorisations, summed over grains
+  /// Work of the contact impulses on the grains over the step, sum_I P_I . (v_I^n + v_I^{n+1}) / 2
+  /// over every grain node (the exact kinetic-energy change they cause on the grid) [J] (2D: J/m).
+  double contact_work = 0;
   std::vector<double> residual_history;  ///< per iteration: max over grains of |R| / reference
   std::string failure;                   ///< why the step failed ("" if converged)
   bool retryable = true;             ///< false if a smaller dt cannot help (a point left the grid)

@@ -75,6 +75,7 @@ ck::State sample() {
   s.wall_point = {0.0, 1.2e-3};
   s.wall_work = {-3.25e-4};
   s.energy0 = 1.5e-5;
+  s.contact_dissipation = 2.5e-6;
   s.ranks = 2;
   s.scheme = "partition";
   s.grain_owner = {1, 0};
@@ -168,6 +169,7 @@ TEST(Checkpoint, RoundTripIsBitwise) {
   EXPECT_TRUE(same(r.wall_point, s.wall_point));
   EXPECT_TRUE(same(r.wall_work, s.wall_work));
   EXPECT_EQ(r.energy0, s.energy0);
+  EXPECT_EQ(r.contact_dissipation, s.contact_dissipation);
   EXPECT_EQ(r.grain, s.grain);
   EXPECT_EQ(r.grain_begin, s.grain_begin);
   EXPECT_EQ(r.grain_end, s.grain_end);
