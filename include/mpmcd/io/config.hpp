@@ -98,7 +98,7 @@ struct SolverSection {
   int cg_max_iterations = 1000;        ///< CG iteration limit [-]
   double flip = 1.0;    ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
   bool affine = false;  ///< affine P2G with the points' velocity gradients (APIC/TPIC)
-  bool modified_newton = false;  ///< reuse the step's first factorisation (modified Newton)
+  bool modified_newton = true;  ///< reuse the step's first factorisation (modified Newton)
 };
 
 /// [[contact.pairs]]: friction between two materials.

@@ -94,7 +94,7 @@ struct Settings {
   /// Modified Newton: factorise the Newton matrix once per step and reuse it (and the contact
   /// compliance computed from it) in the later iterations; refactorised when the residual
   /// stalls. Same converged answer, fewer factorisations (docs/accuracy.md, cost).
-  bool modified_newton = false;
+  bool modified_newton = true;
   Vec<Dim> gravity = Vec<Dim>::Zero();  ///< body acceleration [m/s^2]
   ContactSettings<Dim> contact;         ///< contact between grains and with walls
 };
