@@ -216,6 +216,8 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
   c.mass_fraction = cfg.contact.mass_fraction;
   c.gs.tolerance = cfg.contact.tolerance;
   c.gs.max_sweeps = cfg.contact.max_sweeps;
+  c.gs.relaxation = cfg.contact.relaxation;
+  c.gs.relax_after = cfg.contact.relax_after;
   c.impulse_tolerance = cfg.contact.impulse_tolerance;
   c.wall_range = cfg.contact.wall_range;
   c.wall_points = cfg.contact.wall_contact == "points";

@@ -144,7 +144,20 @@ constexpr std::size_t kThreadedContacts = 1024;
 // One sweep: each contact solved exactly with the others' current impulses (method.md §4), in
 // the serial order within a node; the nodes on the threads (the same impulses for any count).
 template <int Dim>
-void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, StageTimers* timers) {
+Vec<Dim> project_cone(const Vec<Dim>& P, const Vec<Dim>& n, double mu) {
+  // Closest point of the Coulomb cone {p_n >= 0, |p_t| <= mu p_n} to P (in the Euclidean norm).
+  const double pn = P.dot(n);
+  const Vec<Dim> pt = P - pn * n;
+  const double ptn = pt.norm();
+  if (ptn <= mu * pn) return P;
+  if (mu * ptn <= -pn) return Vec<Dim>::Zero();
+  const double qn = (pn + mu * ptn) / (1.0 + mu * mu);
+  return qn * n + (ptn > 0 ? (mu * qn / ptn) * pt : Vec<Dim>(Vec<Dim>::Zero()));
+}
+
+template <int Dim>
+void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, StageTimers* timers,
+           double omega) {
   const auto nr = static_cast<std::int64_t>(runs.start.size()) - 1;
   const ThreadedRegion threaded(timers, p.contacts.size() > kThreadedContacts);
 #pragma omp parallel for schedule(dynamic, 64) if (p.contacts.size() > kThreadedContacts)
@@ -154,7 +167,9 @@ void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, Stag
       Vec<Dim> u;
       Mat<Dim> W;
       free_velocity(p, v, c, u, W);
-      const Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
+      Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
+      if (omega != 1.0 && c.friction == 0.0)  // projected SOR on the normal cone p_n >= 0
+        P = project_cone<Dim>(c.impulse + omega * (P - c.impulse), c.normal, 0.0);
       const Vec<Dim> dP = P - c.impulse;
       if (dP == Vec<Dim>::Zero()) continue;
       respond(p, v, c.b, dP);
@@ -175,7 +190,8 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& 
   auto v = slot_velocities(p);
   const NodeRuns runs = node_runs(p);
   while (r.sweeps < settings.max_sweeps) {
-    sweep(p, v, runs, settings.timers);
+    sweep(p, v, runs, settings.timers,
+          r.sweeps >= settings.relax_after ? settings.relaxation : 1.0);
     ++r.sweeps;
     r.error = error_now();
     if (r.error <= settings.tolerance) {

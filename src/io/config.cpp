@@ -325,6 +325,16 @@ Schema build_schema() {
         KeySpec::integer("max_sweeps", "", "Gauss-Seidel sweep limit")
             .at_least(1)
             .defaults(num(d.contact.max_sweeps)),
+        KeySpec::number("relaxation", "",
+                        "over-relaxation omega of the frictionless contacts' Gauss-Seidel updates "
+                        "(projected SOR): 1 = plain Gauss-Seidel; up to 1.9 speeds up packings "
+                        "where several grains meet at one node (docs/contact.md)")
+            .at_least(1.0)
+            .less_than(2.0)
+            .defaults(num(d.contact.relaxation)),
+        KeySpec::integer("relax_after", "", "Gauss-Seidel sweeps before the over-relaxation starts")
+            .at_least(0)
+            .defaults(num(d.contact.relax_after)),
         KeySpec::number("impulse_tolerance", "",
                         "relative change of impulses between Newton iterations")
             .greater_than(0.0)
@@ -760,6 +770,8 @@ class ConfigReader {
     r.read("mass_fraction", k.mass_fraction);
     r.read("tolerance", k.tolerance);
     r.read("max_sweeps", k.max_sweeps);
+    r.read("relaxation", k.relaxation);
+    r.read("relax_after", k.relax_after);
     r.read("impulse_tolerance", k.impulse_tolerance);
     r.read("wall_range", k.wall_range);
     r.read("wall_contact", k.wall_contact);

@@ -58,6 +58,10 @@ struct Problem {
 struct GsSettings {
   double tolerance = 1e-8;  ///< stop when error(problem) <= tolerance [-]
   int max_sweeps = 1000;    ///< sweep limit [-]
+  /// Over-relaxation omega in [1, 2) of the frictionless contacts' local updates (projected
+  /// SOR, Cryer 1971), from sweep relax_after on; frictional contacts keep omega = 1 [-].
+  double relaxation = 1.0;
+  int relax_after = 0;  ///< sweeps done with omega = 1 before the relaxation starts [-]
   /// Where the threaded sweeps and error sums add their time (ThreadedRegion); none if null.
   StageTimers* timers = nullptr;
 };
