@@ -829,8 +829,11 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
       if (!st.retryable || dt_new < cfg.time.dt_min) {
         if (comm.size() > 1) gather_state(0);
         const std::string saved = root ? out_ptr->last_good(model) : std::string();
-        log().error("last good state (step {}, t = {:.9g} s) written to {}", summary.steps, t,
-                    saved);
+        // Step summary.steps + 1 failed; the state of step summary.steps (time t) is the last
+        // good one: committed steps always keep every point's support on the grid (the solver
+        // checks the positions a step would commit), so its checkpoint can be resumed.
+        log().error("step {} failed; last good state (step {}, t = {:.9g} s) written to {}",
+                    summary.steps + 1, summary.steps, t, saved);
         std::string ckpt;
         try {
           ckpt = write_checkpoint("failure");
@@ -842,6 +845,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                                                 "did not help",
                                                 st.failure, cfg.time.dt_min)
                                           : st.failure;
+        reason += fmt::format(" in step {}, after the last good step {}", summary.steps + 1,
+                              summary.steps);
         if (!ckpt.empty()) reason += fmt::format("; checkpoint of the last good step: {}", ckpt);
         throw NumericalError(reason, summary.steps + 1, t, st.grain, st.point);
       }

@@ -157,6 +157,33 @@ TEST(Cli, PointLeavingTheGridStopsWithExit3) {
   const Result r = run("run " + in.string());
   EXPECT_EQ(r.code, 3) << r.output;
   EXPECT_NE(r.output.find("left the grid"), std::string::npos) << r.output;
+  // Issue 17: the failure checkpoint is the last state that is actually good. The step that would
+  // move a point off the grid fails; the one before it is saved, names one step in every line and
+  // is accepted by --restart, which meets the same failure again (exit 3, not a refusal).
+  std::string ckpt;
+  for (const auto& e : fs::directory_iterator(dir / "out"))
+    if (e.path().extension() == ".h5") ckpt = e.path().string();
+  ASSERT_FALSE(ckpt.empty()) << r.output;
+  const auto state = mpmcd::checkpoint::read(ckpt);
+  EXPECT_EQ(state.reason, "failure");
+  EXPECT_GT(state.step, 0);
+  const std::string failed = "step " + std::to_string(state.step + 1);
+  EXPECT_NE(
+      r.output.find(failed + " failed; last good state (step " + std::to_string(state.step) + ","),
+      std::string::npos)
+      << r.output;
+  EXPECT_NE(
+      r.output.find("in " + failed + ", after the last good step " + std::to_string(state.step) +
+                    "; checkpoint of the last good step: " + ckpt),
+      std::string::npos)
+      << r.output;
+  int outside = 0;  // the grid is [0, 0.02]^2 m
+  for (const double x : state.x) outside += x < 0.0 || x > 0.02;
+  EXPECT_EQ(outside, 0) << "coordinates off the grid in the last good state";
+  const Result again = run("run --restart " + ckpt);
+  EXPECT_EQ(again.code, 3) << again.output;
+  EXPECT_NE(again.output.find("left the grid"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("in " + failed + ","), std::string::npos) << again.output;
 }
 
 TEST(Cli, ListPrintsInputReferenceAndLaws) {
