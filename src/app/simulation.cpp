@@ -18,6 +18,7 @@
 #include "mpmcd/io/load_config.hpp"
 #include "mpmcd/io/vtu.hpp"
 #include "mpmcd/packing/input.hpp"
+#include "mpmcd/packing/overlap.hpp"
 #include "mpmcd/packing/packing.hpp"
 #include "mpmcd/packing/seeding.hpp"
 #include "mpmcd/parallel/distribute.hpp"
@@ -52,8 +53,14 @@ Vec<2> initial_velocity(const io::InitialVelocity& iv, const Vec<2>& c, const Ve
 
 // Every disk of a packing file becomes a grain (points from packing::seed_packing, which gives a
 // lattice site shared by two overlapping disks to one of them only).
+// Grain outlines for the overlap check, and what each one is (grain index, packing disk id or -1).
+struct Outlines {
+  std::vector<packing::Outline> shapes;
+  std::vector<std::pair<std::size_t, std::int64_t>> owner;
+};
+
 void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t index,
-                        int material) {
+                        int material, Outlines& outlines) {
   const auto& g = cfg.grains[index];
   packing::Packing pk;
   if (fs::path(g.file).extension() == ".toml") {  // a packing input: generate it now (seeded DEM)
@@ -71,6 +78,8 @@ void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t
                        fmt::format("the disk (center {:.6g} {:.6g} m, radius {:.6g} m) must lie "
                                    "inside the grid with one cell of margin (grains[{}], {}:{})",
                                    d.x, d.y, d.radius, index, cfg.source_path, g.line));
+    outlines.shapes.push_back({d.x, d.y, 0.0, 0.0, d.radius});
+    outlines.owner.emplace_back(index, d.id);
   }
   if (g.seeding == "polar") {  // each disk on its own rings, strictly inside its circle
     const double s = h / g.points_per_cell;
@@ -125,9 +134,31 @@ mpm::Model<2> model_frame(const io::Config& cfg) {
 
 }  // namespace
 
+// Grains may touch but not overlap (docs/robustness.md): their common area would be counted twice
+// in the volume and Phi. Names both grains (a packing's disk by its id) and the overlap.
+void check_no_overlap(const io::Config& cfg, const Outlines& outlines) {
+  const auto o = packing::find_overlap(outlines.shapes, packing::kOverlapTolerance);
+  if (!o) return;
+  const auto describe = [&](std::size_t k) {
+    const auto [i, id] = outlines.owner[k];
+    const auto& g = cfg.grains[i];
+    return id >= 0 ? fmt::format("disk id {} of {} (grains[{}], line {})", id, g.file, i, g.line)
+                   : fmt::format("grains[{}] (line {})", i, g.line);
+  };
+  const std::size_t later = outlines.owner[o->second].first;
+  throw InputError(
+      cfg.source_path, cfg.grains[later].line, fmt::format("grains[{}]", later),
+      fmt::format("grains that touch but do not overlap (up to {:g} of the smaller one's "
+                  "diameter or side): {} overlaps {} by {:.6g} m = {:.3g} of the smaller size "
+                  "(their common area would be counted twice in the volume and Phi)",
+                  packing::kOverlapTolerance, describe(o->second), describe(o->first), o->depth,
+                  o->depth / o->size));
+}
+
 mpm::Model<2> build_model(const io::Config& cfg) {
   mpm::Model<2> model = model_frame(cfg);
   const double h = cfg.grid.cell_size;
+  Outlines outlines;
   for (std::size_t i = 0; i < cfg.grains.size(); ++i) {
     const auto& g = cfg.grains[i];
     int material = -1;
@@ -137,6 +168,7 @@ mpm::Model<2> build_model(const io::Config& cfg) {
     Vec<2> center;
     if (g.shape == "disk") {
       center = vec2(g.center);
+      outlines.shapes.push_back({center[0], center[1], 0.0, 0.0, g.radius});
       seeds =
           g.seeding == "polar"
               ? points::seed_disk_polar(center, g.radius, h / g.points_per_cell)
@@ -144,14 +176,16 @@ mpm::Model<2> build_model(const io::Config& cfg) {
     } else if (g.shape == "rectangle") {
       const Vec<2> lo = vec2(g.min_corner), hi = vec2(g.max_corner);
       center = 0.5 * (lo + hi);
+      outlines.shapes.push_back({lo[0], lo[1], hi[0], hi[1], 0.0});
       seeds = points::seed_box<2>(model.grid.origin(), h, g.points_per_cell, lo, hi);
     } else if (g.shape == "packing") {
-      add_packing_grains(model, cfg, i, material);
+      add_packing_grains(model, cfg, i, material, outlines);
       continue;
     } else {
       throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].shape", i),
                        "unknown shape \"" + g.shape + "\"");
     }
+    outlines.owner.emplace_back(i, -1);
     if (seeds.x.empty())
       throw InputError(cfg.source_path, g.line, fmt::format("grains[{}]", i),
                        "the grain is too small to hold a material point at this cell size and "
@@ -159,6 +193,7 @@ mpm::Model<2> build_model(const io::Config& cfg) {
     model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
                     [&](const Vec<2>& x) { return initial_velocity(g.initial, center, x); });
   }
+  check_no_overlap(cfg, outlines);
   return model;
 }
 

@@ -8,6 +8,7 @@
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/packing/input.hpp"
+#include "mpmcd/packing/overlap.hpp"
 #include "mpmcd/packing/packing.hpp"
 
 namespace mpmcd::packing {
@@ -26,6 +27,18 @@ int pack_command(const std::string& input_path, bool quiet) {
     const auto at = msg.find(mark);
     throw InputError(input_path, 0, e.key(),
                      at == std::string::npos ? msg : msg.substr(at + mark.size()));
+  }
+  // A packing `mpmcd run` would refuse (overlapping disks, docs/robustness.md) is not written:
+  // exit 3, as a simulation that cannot go on.
+  if (const auto o = find_overlap(disk_outlines(packing), kOverlapTolerance)) {
+    fmt::print(stderr,
+               "mpmcd pack: {}: the packing did not relax: disks {} and {} overlap by {:.3g} of "
+               "the smaller diameter (mpmcd run accepts up to {:g}; largest overlap {:.3g} "
+               "d_mean after {} DEM steps, phi = {:.4f}). Nothing written. Lower target_phi or "
+               "friction (frictional disks jam at a lower phi), or raise max_relax_steps.\n",
+               input_path, packing.disks[o->first].id, packing.disks[o->second].id,
+               o->depth / o->size, kOverlapTolerance, report.max_overlap, report.steps, report.phi);
+    return 3;
   }
   std::error_code ec;
   std::filesystem::create_directories(input.output_folder, ec);

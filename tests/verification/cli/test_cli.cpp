@@ -1,5 +1,6 @@
 // The `mpmcd` command line as a user runs it: exit codes (0 ok, 2 bad input, 3 numerical failure),
 // nothing written for a bad input, the outputs of a run, the last good state after a failure.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -238,4 +239,76 @@ TEST(Cli, PackThenRunGrainsFromThePackingFile) {
   const Result s = run("run " + (dir / "small.toml").string());
   EXPECT_EQ(s.code, 2) << s.output;
   EXPECT_NE(s.output.find("packing.csv: key 'disk "), std::string::npos) << s.output;
+}
+
+// Issue 17: overlapping grains are refused at input (exit 2, both grains and the overlap named,
+// nothing written); touching ones pass. Before, they ran and their common area counted twice.
+TEST(Cli, OverlappingGrainsAreRefusedTouchingOnesPass) {
+  const fs::path dir = scratch("overlap");
+  const auto disks = [](double dx) {
+    return fmt::format(
+        "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.01, 0.01]\n"
+        "radius = 0.001\n[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+        "center = [{:.17g}, 0.01]\nradius = 0.001\n",
+        0.01 + dx);
+  };
+  const std::string time = "[time]\ndt = 1e-5\nend_time = 2e-5\n";
+  const fs::path in = write_input(dir, disks(0.0005), time);
+  for (const std::string cmd : {"check ", "run "}) {
+    const Result r = run(cmd + in.string());
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("case.toml:16: key 'grains[1]': grains that touch but do not "
+                            "overlap (up to 0.001 of the smaller one's diameter or side): "
+                            "grains[1] (line 16) overlaps grains[0] (line 11) by 0.0015 m = 0.75 "
+                            "of the smaller size"),
+              std::string::npos)
+        << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  const Result touching = run("check " + write_input(dir, disks(0.002), time).string());
+  EXPECT_EQ(touching.code, 0) << touching.output;
+  // A packing file with a disk given twice (under another id): refused naming both lines.
+  std::ofstream(dir / "packing.csv") << "# box = 0.002 0.002 0.018 0.018\nid,x,y,radius\n"
+                                        "0,0.005,0.005,0.001\n1,0.01,0.01,0.001\n"
+                                        "2,0.015,0.015,0.001\n3,0.01,0.01,0.001\n";
+  const fs::path pk = write_input(
+      dir, "[[grains]]\nshape = \"packing\"\nfile = \"packing.csv\"\nmaterial = \"gel\"\n", time);
+  const Result dup = run("run " + pk.string());
+  EXPECT_EQ(dup.code, 2) << dup.output;
+  EXPECT_NE(dup.output.find("packing.csv:6: disk id 3 to overlap no other disk"), std::string::npos)
+      << dup.output;
+  EXPECT_NE(dup.output.find("overlaps disk id 1 of line 4 by 0.002 m"), std::string::npos)
+      << dup.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  // A packing disk over an explicit disk: both named.
+  const fs::path mixed =
+      write_input(dir,
+                  "[[grains]]\nshape = \"packing\"\nfile = \"packing.csv\"\nmaterial = \"gel\"\n"
+                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.0155, 0.015]\n"
+                  "radius = 0.001\n",
+                  time);
+  std::ofstream(dir / "packing.csv") << "# box = 0.002 0.002 0.018 0.018\nid,x,y,radius\n"
+                                        "0,0.005,0.005,0.001\n1,0.01,0.01,0.001\n"
+                                        "2,0.015,0.015,0.001\n";
+  const Result mix = run("check " + mixed.string());
+  EXPECT_EQ(mix.code, 2) << mix.output;
+  EXPECT_NE(mix.output.find("grains[1] (line 15) overlaps disk id 2 of "), std::string::npos)
+      << mix.output;
+}
+
+// Issue 17: `mpmcd pack` does not write a packing that did not relax (one `run` would refuse):
+// exit 3, a message saying so and what to change, nothing written.
+TEST(Cli, PackRefusesToWriteAPackingThatDidNotRelax) {
+  const fs::path dir = scratch("unrelaxed");
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ncount = 40\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "aspect_ratio = 1.0\ntarget_phi = 0.78\nfriction = 0.3\nseed = 7\n"
+         "max_relax_steps = 2000\n[output]\nfolder = \""
+      << (dir / "out").string() << "\"\nname = \"packing\"\n";
+  const Result p = run("pack -q " + (dir / "pack.toml").string());
+  EXPECT_EQ(p.code, 3) << p.output;
+  EXPECT_NE(p.output.find("pack.toml: the packing did not relax: disks "), std::string::npos)
+      << p.output;
+  EXPECT_NE(p.output.find("Nothing written"), std::string::npos) << p.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "packing.csv"));
 }
