@@ -7,15 +7,26 @@
 
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
+#include "mpmcd/io/output_folder.hpp"
 #include "mpmcd/packing/input.hpp"
 #include "mpmcd/packing/overlap.hpp"
 #include "mpmcd/packing/packing.hpp"
 
 namespace mpmcd::packing {
 
-int pack_command(const std::string& input_path, bool quiet) {
+int pack_command(const std::string& input_path, bool quiet, bool overwrite) {
   if (quiet) setup_logging(Verbosity::kQuiet);
   const PackingInput input = load_packing_input(input_path);
+  // One folder, one packing of this name (docs/robustness.md, "Output folders"): checked before
+  // the DEM runs, the files removed (--overwrite) only once the new packing is known to relax.
+  const auto earlier = io::files_in(input.output_folder, [&](const std::string& f) {
+    for (const char* ext : {".csv", ".vtu", ".csv.tmp", ".vtu.tmp"})
+      if (f == input.output_name + ext) return true;
+    return false;
+  });
+  const std::string what = fmt::format("packing named '{}'", input.output_name);
+  if (!overwrite)
+    io::claim_output_folder(input.output_folder, earlier, false, what, input_path, "output.folder");
   PackingReport report;
   Packing packing;
   try {
@@ -40,6 +51,8 @@ int pack_command(const std::string& input_path, bool quiet) {
                o->depth / o->size, kOverlapTolerance, report.max_overlap, report.steps, report.phi);
     return 3;
   }
+  io::claim_output_folder(input.output_folder, earlier, overwrite, what, input_path,
+                          "output.folder");
   std::error_code ec;
   std::filesystem::create_directories(input.output_folder, ec);
   if (ec)

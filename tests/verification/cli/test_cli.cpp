@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -311,4 +312,74 @@ TEST(Cli, PackRefusesToWriteAPackingThatDidNotRelax) {
       << p.output;
   EXPECT_NE(p.output.find("Nothing written"), std::string::npos) << p.output;
   EXPECT_FALSE(fs::exists(dir / "out" / "packing.csv"));
+}
+
+namespace {
+
+std::vector<std::string> names_in(const fs::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+// Issue 17: a reused output folder never mixes two runs. A folder holding a run (input.toml or
+// files named after the run) is refused with exit 2 and left as it is; --overwrite removes that
+// run's files (and those of the run named in the old input.toml) first. The same for pack.
+TEST(Cli, ReusedOutputFolderIsRefusedUnlessOverwrite) {
+  const fs::path dir = scratch("reuse");
+  const std::string disk =
+      "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.01, 0.01]\nradius = 0.004\n";
+  const fs::path five = write_input(dir, disk, "[time]\ndt = 1e-5\nend_time = 5e-5\n");
+  fs::rename(five, dir / "five.toml");
+  ASSERT_EQ(run("run -q " + (dir / "five.toml").string()).code, 0);
+  const auto first = names_in(dir / "out");
+  EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_000005.vtu"));
+  const std::string csv = read(dir / "out" / "mpmcd.csv");
+  const fs::path three = write_input(dir, disk, "[time]\ndt = 1e-5\nend_time = 3e-5\n");
+  const Result again = run("run -q " + three.string());
+  EXPECT_EQ(again.code, 2) << again.output;
+  EXPECT_NE(again.output.find("case.toml: key 'output.folder': a folder without the files of an "
+                              "earlier run named 'mpmcd', but '"),
+            std::string::npos)
+      << again.output;
+  EXPECT_NE(again.output.find("give --overwrite to remove them first"), std::string::npos)
+      << again.output;
+  EXPECT_EQ(names_in(dir / "out"), first);
+  EXPECT_EQ(read(dir / "out" / "mpmcd.csv"), csv);
+  // --overwrite: only the new run's files, none of the longer first run's snapshots.
+  const Result over = run("run -q --overwrite " + three.string());
+  EXPECT_EQ(over.code, 0) << over.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "mpmcd_000004.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "mpmcd_000005.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "mpmcd_checkpoint_000000005.h5"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_000003.vtu"));
+  EXPECT_EQ(read(dir / "out" / "mpmcd.pvd").find("mpmcd_000004.vtu"), std::string::npos);
+  // A run of another name: refused (the folder holds a run), then it replaces the old one.
+  const fs::path other = write_input(dir, "[simulation]\nname = \"other\"\n" + disk,
+                                     "[time]\ndt = 1e-5\nend_time = 2e-5\n");
+  const Result named = run("run -q " + other.string() + " -o " + (dir / "out").string());
+  EXPECT_EQ(named.code, 2) << named.output;
+  EXPECT_NE(named.output.find("key '-o': a folder without the files of an earlier run (named "
+                              "'mpmcd', this one 'other')"),
+            std::string::npos)
+      << named.output;
+  ASSERT_EQ(run("run -q --overwrite " + other.string() + " -o " + (dir / "out").string()).code, 0);
+  for (const auto& f : names_in(dir / "out"))
+    EXPECT_TRUE(f == "input.toml" || f.rfind("other", 0) == 0) << f << " left in the folder";
+  // mpmcd pack: the same rule for <name>.csv / <name>.vtu.
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ncount = 12\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "aspect_ratio = 1.0\ntarget_phi = 0.7\nseed = 7\n[output]\nfolder = \""
+      << (dir / "pk").string() << "\"\nname = \"packing\"\n";
+  ASSERT_EQ(run("pack -q " + (dir / "pack.toml").string()).code, 0);
+  const Result pack_again = run("pack -q " + (dir / "pack.toml").string());
+  EXPECT_EQ(pack_again.code, 2) << pack_again.output;
+  EXPECT_NE(pack_again.output.find("pack.toml: key 'output.folder': a folder without the files "
+                                   "of an earlier packing named 'packing'"),
+            std::string::npos)
+      << pack_again.output;
+  EXPECT_EQ(run("pack -q --overwrite " + (dir / "pack.toml").string()).code, 0);
 }
