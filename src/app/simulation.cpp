@@ -346,11 +346,14 @@ std::int64_t trim_csv(const std::string& path, std::int64_t rows) {
 class Outputs {
  public:
   // `extra_header`: further CSV columns (CompactionObserver), starting with a comma; `restart`:
-  // the checkpoint a restarted run continues (nullptr: a new run).
+  // the checkpoint a restarted run continues (nullptr: a new run); `history`: the checkpoint's
+  // folder when the restart writes to another folder ("" otherwise), from which the outputs
+  // written before the checkpoint are copied so that the new folder holds the whole run.
   Outputs(const io::Config& cfg, const std::string& dir, const std::string& extra_header,
-          const checkpoint::State* restart)
+          const checkpoint::State* restart, const std::string& history = "")
       : cfg_(cfg), dir_(dir) {
     fs::create_directories(dir_);
+    if (restart && !history.empty()) copy_history(history, *restart);
     // Input copy, stamped with the version that ran it.
     io::write_file_atomic(
         (fs::path(dir_) / "input.toml").string(),
@@ -380,21 +383,57 @@ class Outputs {
       pvd_ = std::make_unique<io::PvdSeries>(
           (fs::path(dir_) / (cfg.simulation.name + ".pvd")).string());
     if (restart && pvd_) {  // the series so far: file names follow from the snapshot index
+      int missing = 0;
       for (const double t : restart->vtu_times) {
-        pvd_->restore(t, fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_));
+        // Only snapshots that are in this folder: a series never lists a missing file.
+        const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
+        if (fs::exists(fs::path(dir_) / name))
+          pvd_->restore(t, name);
+        else
+          ++missing;
         vtu_times_.push_back(t);
         ++vtu_count_;
       }
+      if (missing > 0)
+        log().warn(
+            "{} of the {} snapshots written before the checkpoint are not in {}: the .pvd "
+            "series lists the {} that are",
+            missing, vtu_count_, dir_, vtu_count_ - missing);
     }
+  }
+  // Copies the outputs written up to the checkpoint from its folder `from`: the CSV (trimmed
+  // later to the checkpoint's rows) and every snapshot (points, contacts, pairs) it lists.
+  void copy_history(const std::string& from, const checkpoint::State& restart) {
+    const std::string& name = cfg_.simulation.name;
+    std::vector<std::string> files{name + ".csv"};
+    for (std::size_t k = 0; k < restart.vtu_times.size(); ++k)
+      for (const char* f : {"{}_{:06d}.vtu", "{}_contacts_{:06d}.vtu", "{}_pairs_{:06d}.csv"})
+        files.push_back(fmt::format(fmt::runtime(f), name, k));
+    int copied = 0;
+    for (const auto& f : files) {
+      const fs::path src = fs::path(from) / f, dst = fs::path(dir_) / f;
+      std::error_code ec;
+      if (!fs::is_regular_file(src, ec)) continue;
+      const fs::path tmp = dst.string() + ".tmp";  // atomic, as every output
+      fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
+      if (!ec) fs::rename(tmp, dst, ec);
+      if (ec)
+        throw std::runtime_error(
+            fmt::format("cannot copy '{}' to '{}': {}", src.string(), dst.string(), ec.message()));
+      ++copied;
+    }
+    log().info("restart into {}: copied {} files written before the checkpoint from {}", dir_,
+               copied, from);
   }
   // Restores the contact series of a restart (only runs with contact write it).
   void restore_contacts(const mpm::ImplicitSolver<2>& solver) {
     if (!pvd_ || !solver.settings().contact.enabled) return;
     contacts_pvd_ = std::make_unique<io::PvdSeries>(
         (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
-    for (std::size_t k = 0; k < vtu_times_.size(); ++k)
-      contacts_pvd_->restore(vtu_times_[k],
-                             fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, k));
+    for (std::size_t k = 0; k < vtu_times_.size(); ++k) {
+      const std::string name = fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, k);
+      if (fs::exists(fs::path(dir_) / name)) contacts_pvd_->restore(vtu_times_[k], name);
+    }
   }
   void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& st,
                const mpm::Diagnostics<2>& d, const std::string& extra) {
@@ -708,6 +747,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   const auto& comm = parallel::Comm::world();
   const bool root = comm.rank() == 0;
   if (!root) log().set_level(spdlog::level::off);  // rank 0 reports
+  std::string history_dir;  // a restart written elsewhere: the checkpoint's folder
   {  // a restart continues in its checkpoint's folder; anywhere else the folder must be free
     std::error_code ec;
     const fs::path ckpt_dir = restart ? (fs::path(opt.restart).parent_path().empty()
@@ -716,6 +756,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                                       : fs::path();
     const bool continuing = restart && fs::equivalent(ckpt_dir, summary.output_dir, ec);
     if (!continuing) claim_run_folder(cfg, opt, summary.output_dir, comm);
+    if (restart && !continuing) history_dir = ckpt_dir.string();
   }
   SignalGuard signals;
   mpm::ImplicitSolver<2> solver(model.grid, settings, model.points, model.grains, model.law_ptrs());
@@ -760,8 +801,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   if (!cfg.walls.empty()) ledger_header += ",energy_change,contact_dissipation,energy_unaccounted";
   std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
   if (root)
-    out_ptr = std::make_unique<Outputs>(cfg, summary.output_dir,
-                                        observer.csv_header() + ledger_header, restart);
+    out_ptr = std::make_unique<Outputs>(
+        cfg, summary.output_dir, observer.csv_header() + ledger_header, restart, history_dir);
   // The ledger's CSV fields: work of each wall, E - E0, the contact dissipation D, and the
   // remainder E - E0 - sum of the walls' work + D.
   const auto ledger_fields = [&](const mpm::Diagnostics<2>& d) {

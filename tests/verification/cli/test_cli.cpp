@@ -383,3 +383,51 @@ TEST(Cli, ReusedOutputFolderIsRefusedUnlessOverwrite) {
       << pack_again.output;
   EXPECT_EQ(run("pack -q --overwrite " + (dir / "pack.toml").string()).code, 0);
 }
+
+// Issue 17: `--restart ck.h5 -o elsewhere` makes `elsewhere` hold the whole run: the CSV rows and
+// snapshots written before the checkpoint are copied from its folder, so every file the .pvd
+// series list is there, and the folder equals that of an uninterrupted run (same thread count).
+TEST(Cli, RestartIntoAnotherFolderHoldsTheWholeRun) {
+  const fs::path dir = scratch("moved");
+  const fs::path in = write_input(dir,
+                                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                                  "center = [0.006, 0.01]\nradius = 0.003\n"
+                                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                                  "center = [0.014, 0.01]\nradius = 0.003\n",
+                                  "[time]\ndt = 1e-5\nend_time = 1e-4\n");
+  const std::string base = "run -q -t 1 " + in.string() + " -o ";
+  ASSERT_EQ(run(base + (dir / "full").string()).code, 0);
+  ASSERT_EQ(run(base + (dir / "part").string() + " --stop-after 4").code, 4);
+  const fs::path ckpt = dir / "part" / "mpmcd_checkpoint_000000004.h5";
+  ASSERT_TRUE(fs::exists(ckpt));
+  const Result r =
+      run("run -q -t 1 --restart " + ckpt.string() + " -o " + (dir / "moved").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto listed = [](const fs::path& pvd) {
+    std::vector<std::string> files;
+    const std::string text = read(pvd);
+    for (std::size_t at = text.find("file=\""); at != std::string::npos;
+         at = text.find("file=\"", at + 1))
+      files.push_back(text.substr(at + 6, text.find('"', at + 6) - at - 6));
+    return files;
+  };
+  for (const char* series : {"mpmcd.pvd", "mpmcd_contacts.pvd"}) {
+    const auto files = listed(dir / "moved" / series);
+    EXPECT_EQ(files.size(), 11u) << series;
+    for (const auto& f : files) EXPECT_TRUE(fs::exists(dir / "moved" / f)) << f << " listed";
+    EXPECT_EQ(read(dir / "moved" / series), read(dir / "full" / series)) << series;
+  }
+  auto outputs = [](const fs::path& d) {
+    std::vector<std::string> out;
+    for (const auto& f : names_in(d))
+      if (f.find("timers") == std::string::npos && f != "input.toml") out.push_back(f);
+    return out;
+  };
+  EXPECT_EQ(outputs(dir / "moved"), outputs(dir / "full"));
+  for (const auto& f : outputs(dir / "full"))
+    EXPECT_EQ(read(dir / "moved" / f), read(dir / "full" / f)) << f;
+  // A restart into a folder holding another run is refused like a new run.
+  const Result taken =
+      run("run -q -t 1 --restart " + ckpt.string() + " -o " + (dir / "full").string());
+  EXPECT_EQ(taken.code, 2) << taken.output;
+}
