@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -528,7 +530,9 @@ class Outputs {
   void write_row(const std::string& row) {
     csv_.write(row.data(), static_cast<std::streamsize>(row.size()));
     csv_.flush();
-    if (!csv_) throw std::runtime_error("cannot write " + csv_path_);
+    if (!csv_)
+      throw std::runtime_error(fmt::format("cannot write '{}': {}", csv_path_,
+                                           std::strerror(errno)));  // e.g. no space left
   }
 
   std::ofstream csv_;

@@ -82,6 +82,8 @@ Packing read_packing_csv(const std::string& path) {
     return InputError(path, line, key, what);
   };
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw fail(0, "", "a packing file (CSV), but it is a directory");
   const auto bytes = std::filesystem::file_size(path, ec);
   if (ec) throw fail(0, "", "cannot read the packing file: " + ec.message());
   if (bytes > kMaxFileBytes)

@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -430,4 +432,53 @@ TEST(Cli, RestartIntoAnotherFolderHoldsTheWholeRun) {
   const Result taken =
       run("run -q -t 1 --restart " + ckpt.string() + " -o " + (dir / "full").string());
   EXPECT_EQ(taken.code, 2) << taken.output;
+}
+
+// Issue 17, messages. A full disk: the reason is named and no .tmp file is left behind (a
+// file-size limit stands in for the full disk: write(2) fails with EFBIG, SIGXFSZ ignored; `pack`,
+// which does not start MPI, whose start-up needs a few MB of files).
+TEST(Cli, AFailedWriteNamesTheReasonAndLeavesNoTmp) {
+  const fs::path dir = scratch("full");
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ncount = 40\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "aspect_ratio = 1.0\ntarget_phi = 0.7\nseed = 7\n[output]\nfolder = \""
+      << (dir / "out").string() << "\"\nname = \"packing\"\n";
+  const std::string cmd = "trap '' XFSZ; ulimit -f 2; " + std::string(MPMCD_BINARY) + " pack -q " +
+                          (dir / "pack.toml").string() + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pclose(pipe);
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 1) << out;
+  EXPECT_NE(out.find("mpmcd: error: cannot write '" + (dir / "out" / "packing.csv.tmp").string() +
+                     "': " + std::strerror(EFBIG)),
+            std::string::npos)
+      << out;
+  for (const auto& f : names_in(dir / "out"))
+    EXPECT_NE(fs::path(f).extension(), ".tmp") << f << " left behind";
+}
+
+// `mpmcd pack` given a simulation input names the missing [packing] table; a packing path that
+// is a directory is called a directory.
+TEST(Cli, PackOfASimulationInputAndAPackingThatIsADirectory) {
+  const Result p = run("pack " + example());
+  EXPECT_EQ(p.code, 2) << p.output;
+  EXPECT_NE(p.output.find("squeezed_disk.toml: key 'packing': a [packing] table (docs/packing.md "
+                          "§5): this looks like a simulation input, which `mpmcd run` takes"),
+            std::string::npos)
+      << p.output;
+  const fs::path dir = scratch("dirpacking");
+  fs::create_directories(dir / "pk");
+  const fs::path in =
+      write_input(dir, "[[grains]]\nshape = \"packing\"\nfile = \"pk\"\nmaterial = \"gel\"\n",
+                  "[time]\ndt = 1e-5\nend_time = 5e-5\n");
+  const Result c = run("check " + in.string());
+  EXPECT_EQ(c.code, 2) << c.output;
+  EXPECT_NE(c.output.find("is a directory"), std::string::npos) << c.output;
+  EXPECT_EQ(c.output.find("not found"), std::string::npos) << c.output;
+  const Result d = run("pack " + dir.string());
+  EXPECT_EQ(d.code, 2) << d.output;
+  EXPECT_NE(d.output.find("it is a directory"), std::string::npos) << d.output;
 }
