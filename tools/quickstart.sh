@@ -9,8 +9,8 @@ tools/install_deps.sh
 cmake --preset release
 cmake --build --preset release --target mpmcd
 out=output/quick_compaction
-./build/release/mpmcd run examples/quick_compaction/quick_compaction.toml -o "$out"
-./build/release/mpmcd analyze "$out" -o "$out/analysis"
+./build/release/mpmcd run examples/quick_compaction/quick_compaction.toml -o "$out" --overwrite
+./build/release/mpmcd analyze "$out" -o "$out/analysis" --overwrite
 /usr/bin/python3 tools/plot_snapshots.py "$out" --phi 0.78 0.9 0.97 --field pressure -o "$out/snapshots"
 echo "quickstart: outputs in $out (time series quick_compaction.csv, quick_compaction.pvd for" \
   "ParaView, analysis/figure4.png and figure5.png, snapshots/*.png)"

@@ -12,6 +12,7 @@
 
 #include "mpmcd/analysis/time_series.hpp"
 #include "mpmcd/core/errors.hpp"
+#include "mpmcd/io/output_folder.hpp"
 #include "mpmcd/io/vtu.hpp"
 
 #ifndef MPMCD_TOOLS_DIR
@@ -158,6 +159,19 @@ int analyze_command(const AnalyzeOptions& opt) {
   if (out_dir.empty())
     out_dir = runs.size() == 1 ? (fs::path(runs[0].folder) / "analysis").string()
                                : std::string("compaction_analysis");
+  // One folder, one analysis (docs/robustness.md, "Output folders"): an earlier one is refused
+  // unless --overwrite, which removes its files (with the PNGs a --no-plots run would not replace).
+  io::claim_output_folder(
+      out_dir,
+      io::files_in(out_dir,
+                   [](const std::string& f) {
+                     for (const char* own : {"compaction_fit.csv", "figure4.csv", "figure5.csv",
+                                             "figure4.png", "figure5.png"})
+                       if (f == own || f == std::string(own) + ".tmp") return true;
+                     return false;
+                   }),
+      opt.overwrite, "analysis", opt.folders.front(),
+      opt.output_dir.empty() ? "analysis folder" : "-o");
   fs::create_directories(out_dir);
 
   std::string fit_csv =

@@ -49,6 +49,9 @@ int run_cli(int argc, char** argv) {
                   "checkpoint and exit 4 (chunks of a long run under a job time limit)")
       ->check(CLI::PositiveNumber);
   run->add_flag("-q,--quiet", run_opt.quiet, "no progress or info lines");
+  run->add_flag("--overwrite", run_opt.overwrite,
+                "replace an earlier run in the output folder (its files are removed first); "
+                "without it such a folder is refused, except a restart's own folder");
   run->add_option("-o,--output", run_opt.output_dir, "output folder (overrides [output] folder)");
   run->add_option("-t,--threads", run_opt.threads, "OpenMP threads (overrides [simulation])")
       ->check(CLI::Range(1, 1024));
@@ -76,6 +79,9 @@ int run_cli(int argc, char** argv) {
   auto* pack = cli.add_subcommand("pack", "generate a disk packing by DEM (docs/packing.md)");
   pack->add_option("input", pack_input, "packing input (TOML)")->required();
   pack->add_flag("-q,--quiet", pack_quiet, "only the summary line");
+  bool pack_overwrite = false;
+  pack->add_flag("--overwrite", pack_overwrite,
+                 "replace <name>.csv/.vtu if the output folder holds them (else refused)");
 
   AnalyzeOptions analyze_opt;
   auto* analyze =
@@ -93,6 +99,8 @@ int run_cli(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   bool analyze_no_plots = false;
   analyze->add_flag("--no-plots", analyze_no_plots, "write the CSV files only");
+  analyze->add_flag("--overwrite", analyze_opt.overwrite,
+                    "replace an earlier analysis in the output folder (else refused)");
 
   try {
     cli.parse(argc, argv);
@@ -135,7 +143,7 @@ int run_cli(int argc, char** argv) {
                                model.grains.size(), model.points.size());
     } else if (*pack) {
       setup_logging(pack_quiet ? Verbosity::kQuiet : Verbosity::kNormal);
-      return packing::pack_command(pack_input, pack_quiet);
+      return packing::pack_command(pack_input, pack_quiet, pack_overwrite);
     } else if (*analyze) {
       analyze_opt.plots = !analyze_no_plots;
       return analyze_command(analyze_opt);

@@ -3,21 +3,27 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <regex>
 
 #include "mpmcd/app/compaction_observer.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/load_config.hpp"
+#include "mpmcd/io/output_folder.hpp"
 #include "mpmcd/io/vtu.hpp"
 #include "mpmcd/packing/input.hpp"
+#include "mpmcd/packing/overlap.hpp"
 #include "mpmcd/packing/packing.hpp"
 #include "mpmcd/packing/seeding.hpp"
 #include "mpmcd/parallel/distribute.hpp"
@@ -52,8 +58,14 @@ Vec<2> initial_velocity(const io::InitialVelocity& iv, const Vec<2>& c, const Ve
 
 // Every disk of a packing file becomes a grain (points from packing::seed_packing, which gives a
 // lattice site shared by two overlapping disks to one of them only).
+// Grain outlines for the overlap check, and what each one is (grain index, packing disk id or -1).
+struct Outlines {
+  std::vector<packing::Outline> shapes;
+  std::vector<std::pair<std::size_t, std::int64_t>> owner;
+};
+
 void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t index,
-                        int material) {
+                        int material, Outlines& outlines) {
   const auto& g = cfg.grains[index];
   packing::Packing pk;
   if (fs::path(g.file).extension() == ".toml") {  // a packing input: generate it now (seeded DEM)
@@ -71,6 +83,8 @@ void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t
                        fmt::format("the disk (center {:.6g} {:.6g} m, radius {:.6g} m) must lie "
                                    "inside the grid with one cell of margin (grains[{}], {}:{})",
                                    d.x, d.y, d.radius, index, cfg.source_path, g.line));
+    outlines.shapes.push_back({d.x, d.y, 0.0, 0.0, d.radius});
+    outlines.owner.emplace_back(index, d.id);
   }
   if (g.seeding == "polar") {  // each disk on its own rings, strictly inside its circle
     const double s = h / g.points_per_cell;
@@ -125,9 +139,31 @@ mpm::Model<2> model_frame(const io::Config& cfg) {
 
 }  // namespace
 
+// Grains may touch but not overlap (docs/robustness.md): their common area would be counted twice
+// in the volume and Phi. Names both grains (a packing's disk by its id) and the overlap.
+void check_no_overlap(const io::Config& cfg, const Outlines& outlines) {
+  const auto o = packing::find_overlap(outlines.shapes, packing::kOverlapTolerance);
+  if (!o) return;
+  const auto describe = [&](std::size_t k) {
+    const auto [i, id] = outlines.owner[k];
+    const auto& g = cfg.grains[i];
+    return id >= 0 ? fmt::format("disk id {} of {} (grains[{}], line {})", id, g.file, i, g.line)
+                   : fmt::format("grains[{}] (line {})", i, g.line);
+  };
+  const std::size_t later = outlines.owner[o->second].first;
+  throw InputError(
+      cfg.source_path, cfg.grains[later].line, fmt::format("grains[{}]", later),
+      fmt::format("grains that touch but do not overlap (up to {:g} of the smaller one's "
+                  "diameter or side): {} overlaps {} by {:.6g} m = {:.3g} of the smaller size "
+                  "(their common area would be counted twice in the volume and Phi)",
+                  packing::kOverlapTolerance, describe(o->second), describe(o->first), o->depth,
+                  o->depth / o->size));
+}
+
 mpm::Model<2> build_model(const io::Config& cfg) {
   mpm::Model<2> model = model_frame(cfg);
   const double h = cfg.grid.cell_size;
+  Outlines outlines;
   for (std::size_t i = 0; i < cfg.grains.size(); ++i) {
     const auto& g = cfg.grains[i];
     int material = -1;
@@ -137,6 +173,7 @@ mpm::Model<2> build_model(const io::Config& cfg) {
     Vec<2> center;
     if (g.shape == "disk") {
       center = vec2(g.center);
+      outlines.shapes.push_back({center[0], center[1], 0.0, 0.0, g.radius});
       seeds =
           g.seeding == "polar"
               ? points::seed_disk_polar(center, g.radius, h / g.points_per_cell)
@@ -144,14 +181,16 @@ mpm::Model<2> build_model(const io::Config& cfg) {
     } else if (g.shape == "rectangle") {
       const Vec<2> lo = vec2(g.min_corner), hi = vec2(g.max_corner);
       center = 0.5 * (lo + hi);
+      outlines.shapes.push_back({lo[0], lo[1], hi[0], hi[1], 0.0});
       seeds = points::seed_box<2>(model.grid.origin(), h, g.points_per_cell, lo, hi);
     } else if (g.shape == "packing") {
-      add_packing_grains(model, cfg, i, material);
+      add_packing_grains(model, cfg, i, material, outlines);
       continue;
     } else {
       throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].shape", i),
                        "unknown shape \"" + g.shape + "\"");
     }
+    outlines.owner.emplace_back(i, -1);
     if (seeds.x.empty())
       throw InputError(cfg.source_path, g.line, fmt::format("grains[{}]", i),
                        "the grain is too small to hold a material point at this cell size and "
@@ -159,6 +198,7 @@ mpm::Model<2> build_model(const io::Config& cfg) {
     model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
                     [&](const Vec<2>& x) { return initial_velocity(g.initial, center, x); });
   }
+  check_no_overlap(cfg, outlines);
   return model;
 }
 
@@ -310,11 +350,14 @@ std::int64_t trim_csv(const std::string& path, std::int64_t rows) {
 class Outputs {
  public:
   // `extra_header`: further CSV columns (CompactionObserver), starting with a comma; `restart`:
-  // the checkpoint a restarted run continues (nullptr: a new run).
+  // the checkpoint a restarted run continues (nullptr: a new run); `history`: the checkpoint's
+  // folder when the restart writes to another folder ("" otherwise), from which the outputs
+  // written before the checkpoint are copied so that the new folder holds the whole run.
   Outputs(const io::Config& cfg, const std::string& dir, const std::string& extra_header,
-          const checkpoint::State* restart)
+          const checkpoint::State* restart, const std::string& history = "")
       : cfg_(cfg), dir_(dir) {
     fs::create_directories(dir_);
+    if (restart && !history.empty()) copy_history(history, *restart);
     // Input copy, stamped with the version that ran it.
     io::write_file_atomic(
         (fs::path(dir_) / "input.toml").string(),
@@ -344,21 +387,57 @@ class Outputs {
       pvd_ = std::make_unique<io::PvdSeries>(
           (fs::path(dir_) / (cfg.simulation.name + ".pvd")).string());
     if (restart && pvd_) {  // the series so far: file names follow from the snapshot index
+      int missing = 0;
       for (const double t : restart->vtu_times) {
-        pvd_->restore(t, fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_));
+        // Only snapshots that are in this folder: a series never lists a missing file.
+        const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
+        if (fs::exists(fs::path(dir_) / name))
+          pvd_->restore(t, name);
+        else
+          ++missing;
         vtu_times_.push_back(t);
         ++vtu_count_;
       }
+      if (missing > 0)
+        log().warn(
+            "{} of the {} snapshots written before the checkpoint are not in {}: the .pvd "
+            "series lists the {} that are",
+            missing, vtu_count_, dir_, vtu_count_ - missing);
     }
+  }
+  // Copies the outputs written up to the checkpoint from its folder `from`: the CSV (trimmed
+  // later to the checkpoint's rows) and every snapshot (points, contacts, pairs) it lists.
+  void copy_history(const std::string& from, const checkpoint::State& restart) {
+    const std::string& name = cfg_.simulation.name;
+    std::vector<std::string> files{name + ".csv"};
+    for (std::size_t k = 0; k < restart.vtu_times.size(); ++k)
+      for (const char* f : {"{}_{:06d}.vtu", "{}_contacts_{:06d}.vtu", "{}_pairs_{:06d}.csv"})
+        files.push_back(fmt::format(fmt::runtime(f), name, k));
+    int copied = 0;
+    for (const auto& f : files) {
+      const fs::path src = fs::path(from) / f, dst = fs::path(dir_) / f;
+      std::error_code ec;
+      if (!fs::is_regular_file(src, ec)) continue;
+      const fs::path tmp = dst.string() + ".tmp";  // atomic, as every output
+      fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
+      if (!ec) fs::rename(tmp, dst, ec);
+      if (ec)
+        throw std::runtime_error(
+            fmt::format("cannot copy '{}' to '{}': {}", src.string(), dst.string(), ec.message()));
+      ++copied;
+    }
+    log().info("restart into {}: copied {} files written before the checkpoint from {}", dir_,
+               copied, from);
   }
   // Restores the contact series of a restart (only runs with contact write it).
   void restore_contacts(const mpm::ImplicitSolver<2>& solver) {
     if (!pvd_ || !solver.settings().contact.enabled) return;
     contacts_pvd_ = std::make_unique<io::PvdSeries>(
         (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
-    for (std::size_t k = 0; k < vtu_times_.size(); ++k)
-      contacts_pvd_->restore(vtu_times_[k],
-                             fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, k));
+    for (std::size_t k = 0; k < vtu_times_.size(); ++k) {
+      const std::string name = fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, k);
+      if (fs::exists(fs::path(dir_) / name)) contacts_pvd_->restore(vtu_times_[k], name);
+    }
   }
   void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& st,
                const mpm::Diagnostics<2>& d, const std::string& extra) {
@@ -453,7 +532,9 @@ class Outputs {
   void write_row(const std::string& row) {
     csv_.write(row.data(), static_cast<std::streamsize>(row.size()));
     csv_.flush();
-    if (!csv_) throw std::runtime_error("cannot write " + csv_path_);
+    if (!csv_)
+      throw std::runtime_error(fmt::format("cannot write '{}': {}", csv_path_,
+                                           std::strerror(errno)));  // e.g. no space left
   }
 
   std::ofstream csv_;
@@ -565,6 +646,67 @@ mpm::Model<2> restore_model(const io::Config& cfg, const checkpoint::State& s,
   return model;
 }
 
+// The files of the run named `name` in `folder` (docs/robustness.md, "Output folders"): the
+// input copy and every output named after the run, with the .tmp files a crash may leave.
+std::vector<std::string> run_files(const std::string& folder, const std::string& name) {
+  const std::regex own("(input\\.toml|" + io::regex_escape(name) +
+                       "(\\.csv|\\.pvd|_contacts\\.pvd|_[0-9]{6}\\.vtu|_contacts_[0-9]{6}\\.vtu|"
+                       "_pairs_[0-9]{6}\\.csv|_checkpoint_[0-9]{9}\\.h5|_last_good\\.vtu|"
+                       "_timers\\.csv))(\\.tmp)?");
+  return io::files_in(folder, [&](const std::string& f) { return std::regex_match(f, own); });
+}
+
+// The run name in an input copy (<folder>/input.toml) of an earlier run: [simulation] name, by
+// default "mpmcd"; "" if the file cannot be read.
+std::string earlier_run_name(const fs::path& input_copy) {
+  std::ifstream in(input_copy);
+  if (!in) return "";
+  const std::regex table(R"re(\s*\[\s*([A-Za-z0-9_.]+)\s*\].*)re");
+  const std::regex key(R"re(\s*name\s*=\s*"([A-Za-z0-9_.-]+)".*)re");
+  std::string line, section, name = io::Config{}.simulation.name;
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (std::regex_match(line, m, table))
+      section = m[1];
+    else if (section == "simulation" && std::regex_match(line, m, key))
+      name = m[1];
+  }
+  return name;
+}
+
+// One folder, one run: a new run (or a restart written elsewhere than its checkpoint's folder)
+// refuses a folder that holds input.toml or files of a run of this name, unless `overwrite`,
+// which removes them, and those of the run named in the old input.toml, first. Rank 0 looks and
+// tells the others.
+void claim_run_folder(const io::Config& cfg, const RunOptions& opt, const std::string& dir,
+                      const parallel::Comm& comm) {
+  std::vector<char> verdict;
+  if (comm.rank() == 0) {
+    try {
+      auto files = run_files(dir, cfg.simulation.name);
+      const std::string earlier = earlier_run_name(fs::path(dir) / "input.toml");
+      if (opt.overwrite && !earlier.empty() && earlier != cfg.simulation.name)
+        for (auto& f : run_files(dir, earlier)) files.push_back(f);
+      std::sort(files.begin(), files.end());
+      files.erase(std::unique(files.begin(), files.end()), files.end());
+      const std::string what =
+          earlier.empty() || earlier == cfg.simulation.name
+              ? fmt::format("run named '{}'", cfg.simulation.name)
+              : fmt::format("run (named '{}', this one '{}')", earlier, cfg.simulation.name);
+      io::claim_output_folder(dir, files, opt.overwrite, what,
+                              opt.restart.empty() ? cfg.source_path : opt.restart,
+                              opt.output_dir.empty() ? "output.folder" : "-o");
+      if (opt.overwrite && !files.empty())
+        log().info("--overwrite: removed {} files of the earlier run in {}", files.size(), dir);
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      verdict.assign(m.begin(), m.end());
+    }
+  }
+  if (comm.size() > 1) comm.broadcast(verdict, 0);
+  if (!verdict.empty()) throw InputError(std::string(verdict.begin(), verdict.end()));
+}
+
 }  // namespace
 
 Restart load_restart(const std::string& path, const std::string& input) {
@@ -611,6 +753,17 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   const auto& comm = parallel::Comm::world();
   const bool root = comm.rank() == 0;
   if (!root) log().set_level(spdlog::level::off);  // rank 0 reports
+  std::string history_dir;  // a restart written elsewhere: the checkpoint's folder
+  {  // a restart continues in its checkpoint's folder; anywhere else the folder must be free
+    std::error_code ec;
+    const fs::path ckpt_dir = restart ? (fs::path(opt.restart).parent_path().empty()
+                                             ? fs::path(".")
+                                             : fs::path(opt.restart).parent_path())
+                                      : fs::path();
+    const bool continuing = restart && fs::equivalent(ckpt_dir, summary.output_dir, ec);
+    if (!continuing) claim_run_folder(cfg, opt, summary.output_dir, comm);
+    if (restart && !continuing) history_dir = ckpt_dir.string();
+  }
   SignalGuard signals;
   mpm::ImplicitSolver<2> solver(model.grid, settings, model.points, model.grains, model.law_ptrs());
   solver.set_boundary_conditions(build_boundaries(cfg, model.grid, 0.0));
@@ -654,8 +807,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   if (!cfg.walls.empty()) ledger_header += ",energy_change,contact_dissipation,energy_unaccounted";
   std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
   if (root)
-    out_ptr = std::make_unique<Outputs>(cfg, summary.output_dir,
-                                        observer.csv_header() + ledger_header, restart);
+    out_ptr = std::make_unique<Outputs>(
+        cfg, summary.output_dir, observer.csv_header() + ledger_header, restart, history_dir);
   // The ledger's CSV fields: work of each wall, E - E0, the contact dissipation D, and the
   // remainder E - E0 - sum of the walls' work + D.
   const auto ledger_fields = [&](const mpm::Diagnostics<2>& d) {
@@ -831,8 +984,11 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
       if (!st.retryable || dt_new < cfg.time.dt_min) {
         if (comm.size() > 1) gather_state(0);
         const std::string saved = root ? out_ptr->last_good(model) : std::string();
-        log().error("last good state (step {}, t = {:.9g} s) written to {}", summary.steps, t,
-                    saved);
+        // Step summary.steps + 1 failed; the state of step summary.steps (time t) is the last
+        // good one: committed steps always keep every point's support on the grid (the solver
+        // checks the positions a step would commit), so its checkpoint can be resumed.
+        log().error("step {} failed; last good state (step {}, t = {:.9g} s) written to {}",
+                    summary.steps + 1, summary.steps, t, saved);
         std::string ckpt;
         try {
           ckpt = write_checkpoint("failure");
@@ -844,6 +1000,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                                                 "did not help",
                                                 st.failure, cfg.time.dt_min)
                                           : st.failure;
+        reason += fmt::format(" in step {}, after the last good step {}", summary.steps + 1,
+                              summary.steps);
         if (!ckpt.empty()) reason += fmt::format("; checkpoint of the last good step: {}", ckpt);
         throw NumericalError(reason, summary.steps + 1, t, st.grain, st.point);
       }

@@ -628,7 +628,13 @@ class ConfigReader {
         const std::filesystem::path folder = std::filesystem::path(source_).parent_path();
         const std::filesystem::path file = (folder / g.file).lexically_normal();
         std::error_code ec;
-        if (!std::filesystem::is_regular_file(file, ec))
+        const auto st = std::filesystem::status(file, ec);
+        if (std::filesystem::is_directory(st))
+          r.fail("file", fmt::format("a packing file (CSV) or packing input (TOML), but \"{}\" "
+                                     "(\"{}\", relative to the input file's folder) is a "
+                                     "directory",
+                                     g.file, file.string()));
+        if (!std::filesystem::is_regular_file(st))
           r.fail("file", fmt::format("packing file \"{}\" not found (looked for \"{}\", relative "
                                      "to the input file's folder)",
                                      g.file, file.string()));

@@ -2,7 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -97,18 +102,37 @@ void PvdSeries::add(double time, const std::string& relative_file) {
 
 void write_file_atomic(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(fmt::format("cannot open '{}' for writing", tmp));
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.flush();
-    if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", tmp));
+  // POSIX calls, so that a failure names its reason (ENOSPC, EDQUOT, EFBIG, EIO...); the
+  // partial .tmp is removed (docs/robustness.md).
+  const auto fail = [&](const char* what, int err) {
+    ::unlink(tmp.c_str());
+    return std::runtime_error(fmt::format("cannot {} '{}': {}", what, tmp, std::strerror(err)));
+  };
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const int err = errno;
+    throw std::runtime_error(
+        fmt::format("cannot open '{}' for writing: {}", tmp, std::strerror(err)));
   }
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ::ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : EIO;
+      ::close(fd);
+      throw fail("write", err);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::close(fd) != 0) throw fail("write", errno);  // e.g. a quota reached on a network FS
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
-  if (ec)
+  if (ec) {
+    ::unlink(tmp.c_str());
     throw std::runtime_error(
         fmt::format("cannot rename '{}' to '{}': {}", tmp, path, ec.message()));
+  }
 }
 
 }  // namespace mpmcd::io

@@ -876,6 +876,22 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.failure += ")";
     return stats;
   }
+  // The state this step commits must be one the next step can start from, and its checkpoint one a
+  // restart accepts: a point whose new position would put its shape-function support past the
+  // grid's edge fails this step (not retryable), so the last good state keeps every point inside.
+  {
+    ScopedStage t(&timers_, "g2p");
+    const ThreadedRegion threaded(&timers_, no > 1);
+#pragma omp parallel for schedule(dynamic, 1) if (no > 1)
+    for (std::size_t i = 0; i < no; ++i) {
+      const std::size_t g = owned_[i];
+      with_shape(settings_.shape, [&](auto tag) { check_next_positions<decltype(tag)>(g); });
+    }
+  }
+  if (collect_failure()) {
+    stats.converged = false;
+    return stats;
+  }
   // Work of the contact impulses on this rank's grains (the energy ledger, docs/accuracy.md):
   // M (v - v^n) = dt f + P makes P . (v^n + v)/2 the kinetic energy the impulses add on the grid.
   for (std::size_t g : owned_) {
@@ -1555,6 +1571,41 @@ void ImplicitSolver<Dim>::commit_grain(std::size_t g) {
     points_.sigma[p] = sigma_trial_[p];
     if constexpr (Dim == 2) points_.sigma_zz[p] = sigma_zz_trial_[p];
     points_.volume[p] = J_trial_[p] * points_.volume0[p];
+  }
+}
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::check_next_positions(std::size_t g) {
+  using Shape = typename grid::ShapeOf<Dim, S1>::type;
+  constexpr int K = Shape::K;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  const double h = grid_.cell_size();
+  Shape ps;
+  for (std::int64_t i = 0; i < gr.size(); ++i) {
+    const std::int64_t p = gr.begin + i;
+    Vec<Dim> dx = Vec<Dim>::Zero();  // as commit_grain: the same sum, the same position
+    for (int a = 0; a < K; ++a) {
+      const std::int32_t n = w.pt_node[i * K + a];
+      if (n >= 0) dx += w.pt_N[i * K + a] * w.du[n];
+    }
+    const Vec<Dim> x = points_.x[p] + dx;
+    // A domain stretched too far is left to the next step's set-up (a retryable failure there);
+    // its position must still lie on the grid.
+    const bool off =
+        !x.allFinite() ||
+        (ps.eval(x, grid_.origin(), h, gr.half_width, F_trial_[p] * points_.domain[p])
+             ? ((ps.first.array() < 0).any() ||
+                ((ps.first.array() + S1::kNodes - 1) >= grid_.nodes_per_axis().array()).any())
+             : !grid_.inside(x, 0.0));
+    if (off) {
+      w.failure =
+          "material point left the grid (or came within the shape-function support of its edge)";
+      w.retryable = false;
+      w.fail_point = p;
+      return;
+    }
   }
 }
 

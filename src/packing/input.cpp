@@ -261,6 +261,8 @@ PackingParams packing_params_from_toml(const toml::table& table, const std::stri
 
 PackingInput load_packing_input(const std::string& path) {
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path, 0, "", "a readable packing input file (TOML); it is a directory");
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(path, 0, "", "a readable packing input file (TOML); it does not exist");
   const auto bytes = std::filesystem::file_size(path, ec);
@@ -283,6 +285,17 @@ PackingInput parse_packing_input(std::string_view text, const std::string& path)
   } catch (const toml::parse_error& e) {
     throw InputError(path, static_cast<std::int64_t>(e.source().begin.line), "",
                      fmt::format("valid TOML: {}", e.description()));
+  }
+  // The missing [packing] table first (the keys come in alphabetical order, so a simulation input
+  // would otherwise be blamed for its first table, e.g. [contact]).
+  if (!root.contains("packing")) {
+    const bool simulation = root.contains("grid") || root.contains("grains") ||
+                            root.contains("materials") || root.contains("time");
+    throw InputError(path, 0, "packing",
+                     simulation ? "a [packing] table (docs/packing.md §5): this looks like a "
+                                  "simulation input, which `mpmcd run` takes (a simulation makes "
+                                  "its packing from [[grains]] shape = \"packing\")"
+                                : "a [packing] table (docs/packing.md §5); the file has none");
   }
   for (const auto& [key, node] : root) {
     const std::string name(key.str());

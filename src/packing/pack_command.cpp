@@ -7,14 +7,26 @@
 
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
+#include "mpmcd/io/output_folder.hpp"
 #include "mpmcd/packing/input.hpp"
+#include "mpmcd/packing/overlap.hpp"
 #include "mpmcd/packing/packing.hpp"
 
 namespace mpmcd::packing {
 
-int pack_command(const std::string& input_path, bool quiet) {
+int pack_command(const std::string& input_path, bool quiet, bool overwrite) {
   if (quiet) setup_logging(Verbosity::kQuiet);
   const PackingInput input = load_packing_input(input_path);
+  // One folder, one packing of this name (docs/robustness.md, "Output folders"): checked before
+  // the DEM runs, the files removed (--overwrite) only once the new packing is known to relax.
+  const auto earlier = io::files_in(input.output_folder, [&](const std::string& f) {
+    for (const char* ext : {".csv", ".vtu", ".csv.tmp", ".vtu.tmp"})
+      if (f == input.output_name + ext) return true;
+    return false;
+  });
+  const std::string what = fmt::format("packing named '{}'", input.output_name);
+  if (!overwrite)
+    io::claim_output_folder(input.output_folder, earlier, false, what, input_path, "output.folder");
   PackingReport report;
   Packing packing;
   try {
@@ -27,6 +39,20 @@ int pack_command(const std::string& input_path, bool quiet) {
     throw InputError(input_path, 0, e.key(),
                      at == std::string::npos ? msg : msg.substr(at + mark.size()));
   }
+  // A packing `mpmcd run` would refuse (overlapping disks, docs/robustness.md) is not written:
+  // exit 3, as a simulation that cannot go on.
+  if (const auto o = find_overlap(disk_outlines(packing), kOverlapTolerance)) {
+    fmt::print(stderr,
+               "mpmcd pack: {}: the packing did not relax: disks {} and {} overlap by {:.3g} of "
+               "the smaller diameter (mpmcd run accepts up to {:g}; largest overlap {:.3g} "
+               "d_mean after {} DEM steps, phi = {:.4f}). Nothing written. Lower target_phi or "
+               "friction (frictional disks jam at a lower phi), or raise max_relax_steps.\n",
+               input_path, packing.disks[o->first].id, packing.disks[o->second].id,
+               o->depth / o->size, kOverlapTolerance, report.max_overlap, report.steps, report.phi);
+    return 3;
+  }
+  io::claim_output_folder(input.output_folder, earlier, overwrite, what, input_path,
+                          "output.folder");
   std::error_code ec;
   std::filesystem::create_directories(input.output_folder, ec);
   if (ec)

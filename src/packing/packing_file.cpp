@@ -12,6 +12,7 @@
 
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/io/vtu.hpp"
+#include "mpmcd/packing/overlap.hpp"
 #include "mpmcd/packing/packing.hpp"
 
 namespace mpmcd::packing {
@@ -81,6 +82,8 @@ Packing read_packing_csv(const std::string& path) {
     return InputError(path, line, key, what);
   };
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw fail(0, "", "a packing file (CSV), but it is a directory");
   const auto bytes = std::filesystem::file_size(path, ec);
   if (ec) throw fail(0, "", "cannot read the packing file: " + ec.message());
   if (bytes > kMaxFileBytes)
@@ -233,6 +236,19 @@ Packing parse_packing_csv(std::string_view text, const std::string& path) {
                              "[{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] of line {}: it is outside",
                              d.id, d.x, d.y, d.radius, packing.xmin, packing.xmax, packing.ymin,
                              packing.ymax, box_line));
+  }
+  // Disks may touch but not overlap (a packing not relaxed, a duplicated row): the common area
+  // would be counted twice in the volume and Phi of a run (docs/robustness.md).
+  if (const auto o = find_overlap(disk_outlines(packing), kOverlapTolerance)) {
+    const auto& a = packing.disks[o->first];
+    const auto& b = packing.disks[o->second];
+    throw fail(row_line[o->second], "",
+               fmt::format("disk id {} to overlap no other disk (touching is fine: up to {:g} of "
+                           "the smaller diameter), but it overlaps disk id {} of line {} by "
+                           "{:.6g} m = {:.3g} of the smaller diameter: a duplicated row or a "
+                           "packing that is not relaxed",
+                           b.id, kOverlapTolerance, a.id, row_line[o->first], o->depth,
+                           o->depth / o->size));
   }
   return packing;
 }

@@ -12,7 +12,8 @@ RTOL = 1e-6  # relative; the Gauss-Seidel tolerance is 1e-8 and the impulse tole
 
 def run(name, ranks, scheme="partition", extra=(), input_file=None):
     out = os.path.join(work, name)
-    cmd = [binary, "run", input_file or toml, "-q", "-t", "1", "-o", out, "--scheme", scheme, *extra]
+    cmd = [binary, "run", input_file or toml, "-q", "-t", "1", "-o", out, "--overwrite", "--scheme",
+           scheme, *extra]
     if ranks > 1:
         cmd = [mpiexec, "--oversubscribe", "--allow-run-as-root", "-np", str(ranks)] + cmd
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)

@@ -15,11 +15,13 @@ struct AnalyzeOptions {
                                        ///< ./compaction_analysis for several
   analysis::JammingCriterion jamming;  ///< Φ_J detection
   bool plots = true;                   ///< run tools/plot_compaction.py for the PNGs
+  bool overwrite = false;  ///< replace an earlier analysis in output_dir (else refused) [-]
 };
 
 /// Analyses the runs, prints the fits and writes compaction_fit.csv, figure4.csv, figure5.csv
 /// (and figure4.png, figure5.png when python3 with matplotlib is found). Throws InputError for a
-/// folder that is not a compaction run (exit 2). Returns the exit code (0).
+/// folder that is not a compaction run (exit 2), and for an output folder that already holds
+/// these files unless `overwrite` (then removed first). Returns the exit code (0).
 int analyze_command(const AnalyzeOptions& options);
 
 }  // namespace mpmcd::app

@@ -22,6 +22,9 @@ struct RunOptions {
                                 ///< interrupted (checkpoint written; for job time limits, tests)
   std::string scheme;  ///< parallel scheme "partition" (default) or "master" (docs/parallel.md)
   double rebalance = 1.01;  ///< partition: re-deal above this work imbalance (partition.hpp) [-]
+  /// Replace an earlier run in the output folder (its files are removed first); without it a
+  /// folder holding a run is refused (InputError), except a restart's own folder [-].
+  bool overwrite = false;
 };
 
 /// Summary of a finished run.

@@ -240,6 +240,10 @@ class ImplicitSolver {
   double update_contacts_distributed(StepStats& stats);
   template <class S1>
   void commit_grain(std::size_t g);
+  // Fails grain g's step (not retryable) if a point's position after it, x + sum N du, would put
+  // its shape-function support past the grid's edge (the check setup_grain makes at x^n).
+  template <class S1>
+  void check_next_positions(std::size_t g);
 
   grid::Grid<Dim> grid_;
   Settings<Dim> settings_;

@@ -1,4 +1,5 @@
 // CSV packing files and TOML packing inputs: round trip, foreign files, malformed content.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -9,6 +10,7 @@
 
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/packing/input.hpp"
+#include "mpmcd/packing/overlap.hpp"
 #include "mpmcd/packing/packing.hpp"
 
 using namespace mpmcd::packing;
@@ -131,6 +133,9 @@ TEST(PackingFile, MalformedFilesAreRejectedWithFileAndLine) {
       {"no_rows.csv", 2, "at least one disk"},
       {"non_integer_id.csv", 3, "key 'id': an integer, got '1.5'"},
       {"does_not_exist.csv", 0, "cannot read"},
+      {"duplicated_disk.csv", 6,
+       "disk id 4 to overlap no other disk (touching is fine: up to 0.001 of the smaller "
+       "diameter), but it overlaps disk id 2 of line 4 by 0.001 m = 1 of the smaller diameter"},
   };
   for (const auto& c : cases) expect_rejected(c, [](const std::string& p) { read_packing_csv(p); });
 }
@@ -165,4 +170,55 @@ TEST(PackingInputFile, ExampleLoads) {
   EXPECT_EQ(in.params.method, PackingMethod::kGrow);
   EXPECT_DOUBLE_EQ(in.params.target_phi, 0.78);
   EXPECT_FALSE(in.params.box.has_value());
+}
+
+// Issue 17: disks may touch (within kOverlapTolerance of the smaller diameter), not overlap.
+TEST(PackingFile, TouchingDisksPassOverlappingOnesAreRefusedWithBothLines) {
+  const auto text = [](double gap) {
+    return fmt::format("id,x,y,radius\n0,0.0,0.0,0.5e-3\n1,{:.17g},0.0,0.5e-3\n", 1e-3 + gap);
+  };
+  EXPECT_EQ(parse_packing_csv(text(0.0), "p.csv").disks.size(), 2u);      // touching
+  EXPECT_EQ(parse_packing_csv(text(-0.9e-6), "p.csv").disks.size(), 2u);  // 9e-4 d
+  try {
+    parse_packing_csv(text(-1.1e-6), "p.csv");  // 1.1e-3 d
+    ADD_FAILURE() << "an overlap of 1.1e-3 d was accepted";
+  } catch (const mpmcd::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p.csv:3: disk id 1 to overlap no other disk"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("overlaps disk id 0 of line 2 by 1.1e-06 m"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Overlap, DisksAndRectanglesInCellsAndAgainstEveryOutline) {
+  // 2000 disks on a lattice, touching their neighbours: no overlap.
+  std::vector<Outline> o;
+  for (int i = 0; i < 2000; ++i) o.push_back({(i % 50) * 2.0, (i / 50) * 2.0, 0, 0, 1.0});
+  EXPECT_FALSE(find_overlap(o, kOverlapTolerance));
+  // A rectangle over the lattice (compared with every disk) overlaps the first disk it reaches.
+  o.push_back({-10.0, -10.0, 200.0, -0.5, 0.0});
+  auto hit = find_overlap(o, kOverlapTolerance);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->first, 0u);
+  EXPECT_EQ(hit->second, 2000u);
+  EXPECT_DOUBLE_EQ(hit->depth, 0.5);
+  o.pop_back();
+  // A disk shifted onto its neighbour: found with the lowest later index.
+  o[1234].x0 -= 0.5;
+  hit = find_overlap(o, kOverlapTolerance);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->first, 1233u);
+  EXPECT_EQ(hit->second, 1234u);
+  EXPECT_DOUBLE_EQ(hit->size, 2.0);
+  // Rectangles: sharing a side is touching; overlapping by 0.1 is not.
+  EXPECT_FALSE(find_overlap({{0, 0, 1, 1, 0}, {1, 0, 2, 1, 0}}, kOverlapTolerance));
+  hit = find_overlap({{0, 0, 1, 1, 0}, {0.9, 0.5, 2, 1, 0}}, kOverlapTolerance);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->depth, 0.1, 1e-12);
+  // A disk whose centre is inside a rectangle.
+  hit = find_overlap({{0, 0, 1, 1, 0}, {0.5, 0.9, 0, 0, 0.05}}, kOverlapTolerance);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->depth, 0.15, 1e-12);
 }

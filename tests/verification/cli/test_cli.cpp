@@ -1,10 +1,14 @@
 // The `mpmcd` command line as a user runs it: exit codes (0 ok, 2 bad input, 3 numerical failure),
 // nothing written for a bad input, the outputs of a run, the last good state after a failure.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -157,6 +161,33 @@ TEST(Cli, PointLeavingTheGridStopsWithExit3) {
   const Result r = run("run " + in.string());
   EXPECT_EQ(r.code, 3) << r.output;
   EXPECT_NE(r.output.find("left the grid"), std::string::npos) << r.output;
+  // Issue 17: the failure checkpoint is the last state that is actually good. The step that would
+  // move a point off the grid fails; the one before it is saved, names one step in every line and
+  // is accepted by --restart, which meets the same failure again (exit 3, not a refusal).
+  std::string ckpt;
+  for (const auto& e : fs::directory_iterator(dir / "out"))
+    if (e.path().extension() == ".h5") ckpt = e.path().string();
+  ASSERT_FALSE(ckpt.empty()) << r.output;
+  const auto state = mpmcd::checkpoint::read(ckpt);
+  EXPECT_EQ(state.reason, "failure");
+  EXPECT_GT(state.step, 0);
+  const std::string failed = "step " + std::to_string(state.step + 1);
+  EXPECT_NE(
+      r.output.find(failed + " failed; last good state (step " + std::to_string(state.step) + ","),
+      std::string::npos)
+      << r.output;
+  EXPECT_NE(
+      r.output.find("in " + failed + ", after the last good step " + std::to_string(state.step) +
+                    "; checkpoint of the last good step: " + ckpt),
+      std::string::npos)
+      << r.output;
+  int outside = 0;  // the grid is [0, 0.02]^2 m
+  for (const double x : state.x) outside += x < 0.0 || x > 0.02;
+  EXPECT_EQ(outside, 0) << "coordinates off the grid in the last good state";
+  const Result again = run("run --restart " + ckpt);
+  EXPECT_EQ(again.code, 3) << again.output;
+  EXPECT_NE(again.output.find("left the grid"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("in " + failed + ","), std::string::npos) << again.output;
 }
 
 TEST(Cli, ListPrintsInputReferenceAndLaws) {
@@ -211,4 +242,243 @@ TEST(Cli, PackThenRunGrainsFromThePackingFile) {
   const Result s = run("run " + (dir / "small.toml").string());
   EXPECT_EQ(s.code, 2) << s.output;
   EXPECT_NE(s.output.find("packing.csv: key 'disk "), std::string::npos) << s.output;
+}
+
+// Issue 17: overlapping grains are refused at input (exit 2, both grains and the overlap named,
+// nothing written); touching ones pass. Before, they ran and their common area counted twice.
+TEST(Cli, OverlappingGrainsAreRefusedTouchingOnesPass) {
+  const fs::path dir = scratch("overlap");
+  const auto disks = [](double dx) {
+    return fmt::format(
+        "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.01, 0.01]\n"
+        "radius = 0.001\n[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+        "center = [{:.17g}, 0.01]\nradius = 0.001\n",
+        0.01 + dx);
+  };
+  const std::string time = "[time]\ndt = 1e-5\nend_time = 2e-5\n";
+  const fs::path in = write_input(dir, disks(0.0005), time);
+  for (const std::string cmd : {"check ", "run "}) {
+    const Result r = run(cmd + in.string());
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("case.toml:16: key 'grains[1]': grains that touch but do not "
+                            "overlap (up to 0.001 of the smaller one's diameter or side): "
+                            "grains[1] (line 16) overlaps grains[0] (line 11) by 0.0015 m = 0.75 "
+                            "of the smaller size"),
+              std::string::npos)
+        << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  const Result touching = run("check " + write_input(dir, disks(0.002), time).string());
+  EXPECT_EQ(touching.code, 0) << touching.output;
+  // A packing file with a disk given twice (under another id): refused naming both lines.
+  std::ofstream(dir / "packing.csv") << "# box = 0.002 0.002 0.018 0.018\nid,x,y,radius\n"
+                                        "0,0.005,0.005,0.001\n1,0.01,0.01,0.001\n"
+                                        "2,0.015,0.015,0.001\n3,0.01,0.01,0.001\n";
+  const fs::path pk = write_input(
+      dir, "[[grains]]\nshape = \"packing\"\nfile = \"packing.csv\"\nmaterial = \"gel\"\n", time);
+  const Result dup = run("run " + pk.string());
+  EXPECT_EQ(dup.code, 2) << dup.output;
+  EXPECT_NE(dup.output.find("packing.csv:6: disk id 3 to overlap no other disk"), std::string::npos)
+      << dup.output;
+  EXPECT_NE(dup.output.find("overlaps disk id 1 of line 4 by 0.002 m"), std::string::npos)
+      << dup.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  // A packing disk over an explicit disk: both named.
+  const fs::path mixed =
+      write_input(dir,
+                  "[[grains]]\nshape = \"packing\"\nfile = \"packing.csv\"\nmaterial = \"gel\"\n"
+                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.0155, 0.015]\n"
+                  "radius = 0.001\n",
+                  time);
+  std::ofstream(dir / "packing.csv") << "# box = 0.002 0.002 0.018 0.018\nid,x,y,radius\n"
+                                        "0,0.005,0.005,0.001\n1,0.01,0.01,0.001\n"
+                                        "2,0.015,0.015,0.001\n";
+  const Result mix = run("check " + mixed.string());
+  EXPECT_EQ(mix.code, 2) << mix.output;
+  EXPECT_NE(mix.output.find("grains[1] (line 15) overlaps disk id 2 of "), std::string::npos)
+      << mix.output;
+}
+
+// Issue 17: `mpmcd pack` does not write a packing that did not relax (one `run` would refuse):
+// exit 3, a message saying so and what to change, nothing written.
+TEST(Cli, PackRefusesToWriteAPackingThatDidNotRelax) {
+  const fs::path dir = scratch("unrelaxed");
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ncount = 40\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "aspect_ratio = 1.0\ntarget_phi = 0.78\nfriction = 0.3\nseed = 7\n"
+         "max_relax_steps = 2000\n[output]\nfolder = \""
+      << (dir / "out").string() << "\"\nname = \"packing\"\n";
+  const Result p = run("pack -q " + (dir / "pack.toml").string());
+  EXPECT_EQ(p.code, 3) << p.output;
+  EXPECT_NE(p.output.find("pack.toml: the packing did not relax: disks "), std::string::npos)
+      << p.output;
+  EXPECT_NE(p.output.find("Nothing written"), std::string::npos) << p.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "packing.csv"));
+}
+
+namespace {
+
+std::vector<std::string> names_in(const fs::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+// Issue 17: a reused output folder never mixes two runs. A folder holding a run (input.toml or
+// files named after the run) is refused with exit 2 and left as it is; --overwrite removes that
+// run's files (and those of the run named in the old input.toml) first. The same for pack.
+TEST(Cli, ReusedOutputFolderIsRefusedUnlessOverwrite) {
+  const fs::path dir = scratch("reuse");
+  const std::string disk =
+      "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.01, 0.01]\nradius = 0.004\n";
+  const fs::path five = write_input(dir, disk, "[time]\ndt = 1e-5\nend_time = 5e-5\n");
+  fs::rename(five, dir / "five.toml");
+  ASSERT_EQ(run("run -q " + (dir / "five.toml").string()).code, 0);
+  const auto first = names_in(dir / "out");
+  EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_000005.vtu"));
+  const std::string csv = read(dir / "out" / "mpmcd.csv");
+  const fs::path three = write_input(dir, disk, "[time]\ndt = 1e-5\nend_time = 3e-5\n");
+  const Result again = run("run -q " + three.string());
+  EXPECT_EQ(again.code, 2) << again.output;
+  EXPECT_NE(again.output.find("case.toml: key 'output.folder': a folder without the files of an "
+                              "earlier run named 'mpmcd', but '"),
+            std::string::npos)
+      << again.output;
+  EXPECT_NE(again.output.find("give --overwrite to remove them first"), std::string::npos)
+      << again.output;
+  EXPECT_EQ(names_in(dir / "out"), first);
+  EXPECT_EQ(read(dir / "out" / "mpmcd.csv"), csv);
+  // --overwrite: only the new run's files, none of the longer first run's snapshots.
+  const Result over = run("run -q --overwrite " + three.string());
+  EXPECT_EQ(over.code, 0) << over.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "mpmcd_000004.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "mpmcd_000005.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "mpmcd_checkpoint_000000005.h5"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_000003.vtu"));
+  EXPECT_EQ(read(dir / "out" / "mpmcd.pvd").find("mpmcd_000004.vtu"), std::string::npos);
+  // A run of another name: refused (the folder holds a run), then it replaces the old one.
+  const fs::path other = write_input(dir, "[simulation]\nname = \"other\"\n" + disk,
+                                     "[time]\ndt = 1e-5\nend_time = 2e-5\n");
+  const Result named = run("run -q " + other.string() + " -o " + (dir / "out").string());
+  EXPECT_EQ(named.code, 2) << named.output;
+  EXPECT_NE(named.output.find("key '-o': a folder without the files of an earlier run (named "
+                              "'mpmcd', this one 'other')"),
+            std::string::npos)
+      << named.output;
+  ASSERT_EQ(run("run -q --overwrite " + other.string() + " -o " + (dir / "out").string()).code, 0);
+  for (const auto& f : names_in(dir / "out"))
+    EXPECT_TRUE(f == "input.toml" || f.rfind("other", 0) == 0) << f << " left in the folder";
+  // mpmcd pack: the same rule for <name>.csv / <name>.vtu.
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ncount = 12\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "aspect_ratio = 1.0\ntarget_phi = 0.7\nseed = 7\n[output]\nfolder = \""
+      << (dir / "pk").string() << "\"\nname = \"packing\"\n";
+  ASSERT_EQ(run("pack -q " + (dir / "pack.toml").string()).code, 0);
+  const Result pack_again = run("pack -q " + (dir / "pack.toml").string());
+  EXPECT_EQ(pack_again.code, 2) << pack_again.output;
+  EXPECT_NE(pack_again.output.find("pack.toml: key 'output.folder': a folder without the files "
+                                   "of an earlier packing named 'packing'"),
+            std::string::npos)
+      << pack_again.output;
+  EXPECT_EQ(run("pack -q --overwrite " + (dir / "pack.toml").string()).code, 0);
+}
+
+// Issue 17: `--restart ck.h5 -o elsewhere` makes `elsewhere` hold the whole run: the CSV rows and
+// snapshots written before the checkpoint are copied from its folder, so every file the .pvd
+// series list is there, and the folder equals that of an uninterrupted run (same thread count).
+TEST(Cli, RestartIntoAnotherFolderHoldsTheWholeRun) {
+  const fs::path dir = scratch("moved");
+  const fs::path in = write_input(dir,
+                                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                                  "center = [0.006, 0.01]\nradius = 0.003\n"
+                                  "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+                                  "center = [0.014, 0.01]\nradius = 0.003\n",
+                                  "[time]\ndt = 1e-5\nend_time = 1e-4\n");
+  const std::string base = "run -q -t 1 " + in.string() + " -o ";
+  ASSERT_EQ(run(base + (dir / "full").string()).code, 0);
+  ASSERT_EQ(run(base + (dir / "part").string() + " --stop-after 4").code, 4);
+  const fs::path ckpt = dir / "part" / "mpmcd_checkpoint_000000004.h5";
+  ASSERT_TRUE(fs::exists(ckpt));
+  const Result r =
+      run("run -q -t 1 --restart " + ckpt.string() + " -o " + (dir / "moved").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto listed = [](const fs::path& pvd) {
+    std::vector<std::string> files;
+    const std::string text = read(pvd);
+    for (std::size_t at = text.find("file=\""); at != std::string::npos;
+         at = text.find("file=\"", at + 1))
+      files.push_back(text.substr(at + 6, text.find('"', at + 6) - at - 6));
+    return files;
+  };
+  for (const char* series : {"mpmcd.pvd", "mpmcd_contacts.pvd"}) {
+    const auto files = listed(dir / "moved" / series);
+    EXPECT_EQ(files.size(), 11u) << series;
+    for (const auto& f : files) EXPECT_TRUE(fs::exists(dir / "moved" / f)) << f << " listed";
+    EXPECT_EQ(read(dir / "moved" / series), read(dir / "full" / series)) << series;
+  }
+  auto outputs = [](const fs::path& d) {
+    std::vector<std::string> out;
+    for (const auto& f : names_in(d))
+      if (f.find("timers") == std::string::npos && f != "input.toml") out.push_back(f);
+    return out;
+  };
+  EXPECT_EQ(outputs(dir / "moved"), outputs(dir / "full"));
+  for (const auto& f : outputs(dir / "full"))
+    EXPECT_EQ(read(dir / "moved" / f), read(dir / "full" / f)) << f;
+  // A restart into a folder holding another run is refused like a new run.
+  const Result taken =
+      run("run -q -t 1 --restart " + ckpt.string() + " -o " + (dir / "full").string());
+  EXPECT_EQ(taken.code, 2) << taken.output;
+}
+
+// Issue 17, messages. A full disk: the reason is named and no .tmp file is left behind (a
+// file-size limit stands in for the full disk: write(2) fails with EFBIG, SIGXFSZ ignored; `pack`,
+// which does not start MPI, whose start-up needs a few MB of files).
+TEST(Cli, AFailedWriteNamesTheReasonAndLeavesNoTmp) {
+  const fs::path dir = scratch("full");
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ncount = 40\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "aspect_ratio = 1.0\ntarget_phi = 0.7\nseed = 7\n[output]\nfolder = \""
+      << (dir / "out").string() << "\"\nname = \"packing\"\n";
+  const std::string cmd = "trap '' XFSZ; ulimit -f 2; " + std::string(MPMCD_BINARY) + " pack -q " +
+                          (dir / "pack.toml").string() + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pclose(pipe);
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 1) << out;
+  EXPECT_NE(out.find("mpmcd: error: cannot write '" + (dir / "out" / "packing.csv.tmp").string() +
+                     "': " + std::strerror(EFBIG)),
+            std::string::npos)
+      << out;
+  for (const auto& f : names_in(dir / "out"))
+    EXPECT_NE(fs::path(f).extension(), ".tmp") << f << " left behind";
+}
+
+// `mpmcd pack` given a simulation input names the missing [packing] table; a packing path that
+// is a directory is called a directory.
+TEST(Cli, PackOfASimulationInputAndAPackingThatIsADirectory) {
+  const Result p = run("pack " + example());
+  EXPECT_EQ(p.code, 2) << p.output;
+  EXPECT_NE(p.output.find("squeezed_disk.toml: key 'packing': a [packing] table (docs/packing.md "
+                          "§5): this looks like a simulation input, which `mpmcd run` takes"),
+            std::string::npos)
+      << p.output;
+  const fs::path dir = scratch("dirpacking");
+  fs::create_directories(dir / "pk");
+  const fs::path in =
+      write_input(dir, "[[grains]]\nshape = \"packing\"\nfile = \"pk\"\nmaterial = \"gel\"\n",
+                  "[time]\ndt = 1e-5\nend_time = 5e-5\n");
+  const Result c = run("check " + in.string());
+  EXPECT_EQ(c.code, 2) << c.output;
+  EXPECT_NE(c.output.find("is a directory"), std::string::npos) << c.output;
+  EXPECT_EQ(c.output.find("not found"), std::string::npos) << c.output;
+  const Result d = run("pack " + dir.string());
+  EXPECT_EQ(d.code, 2) << d.output;
+  EXPECT_NE(d.output.find("it is a directory"), std::string::npos) << d.output;
 }

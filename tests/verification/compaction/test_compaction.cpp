@@ -228,6 +228,17 @@ TEST(Analyze, ThreeSyntheticRunsOverlaidRecoverC1C2) {
   std::size_t lines = 0;
   for (std::string line; std::getline(fig5, line);) ++lines;
   EXPECT_EQ(lines, 1 + 3u * 201u);  // the three runs overlaid
+  // Issue 17: the analysis folder is not reused silently; --overwrite replaces the analysis and
+  // removes its files first (the PNGs a --no-plots analysis would leave stale).
+  const Result again = run(args);
+  EXPECT_EQ(again.code, 2) << again.output;
+  EXPECT_NE(again.output.find("key '-o': a folder without the files of an earlier analysis"),
+            std::string::npos)
+      << again.output;
+  const Result over = run(args + " --no-plots --overwrite");
+  EXPECT_EQ(over.code, 0) << over.output;
+  EXPECT_FALSE(fs::exists(dir / "analysis" / "figure4.png"));
+  EXPECT_TRUE(fs::exists(dir / "analysis" / "figure4.csv"));
 }
 
 TEST(Analyze, GarbageExitsWith2) {
