@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -481,4 +482,27 @@ TEST(Cli, PackOfASimulationInputAndAPackingThatIsADirectory) {
   const Result d = run("pack " + dir.string());
   EXPECT_EQ(d.code, 2) << d.output;
   EXPECT_NE(d.output.find("it is a directory"), std::string::npos) << d.output;
+}
+
+TEST(Cli, CheckRefusesAPackingBoxLargerThanTheGridBeforeTheDem) {
+  // 20,000 disks of 0.8-1.2 mm at Phi = 0.78 need a box of at least 0.14 m; the grid is 6 mm. The
+  // refusal must come from the box (known before the DEM), not after running it (18 s before).
+  const fs::path dir = scratch("packbox");
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ncount = 20000\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "aspect_ratio = 1.0\norigin = [0.0, 0.0]\ntarget_phi = 0.78\nmethod = \"grow\"\n"
+         "seed = 7\n[output]\nfolder = \"out\"\nname = \"packing\"\n";
+  std::ofstream(dir / "run.toml")
+      << "[grid]\norigin = [-0.001, -0.001]\nextent = [0.006, 0.006]\ncell_size = 0.000125\n"
+         "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\n"
+         "lambda = 3e6\nmu = 1.5e6\n[[grains]]\nshape = \"packing\"\nfile = \"pack.toml\"\n"
+         "material = \"gel\"\n[time]\ndt = 1e-7\nend_time = 5e-7\n[output]\nfolder = \"out\"\n";
+  const auto t0 = std::chrono::steady_clock::now();
+  const Result c = run("check " + (dir / "run.toml").string());
+  const double secs =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(c.code, 2) << c.output;
+  EXPECT_NE(c.output.find("packing box"), std::string::npos) << c.output;
+  EXPECT_NE(c.output.find("checked before the DEM runs"), std::string::npos) << c.output;
+  EXPECT_LT(secs, 5.0) << "the DEM ran before the box was checked";
 }
