@@ -82,11 +82,12 @@ void check_packing_box(const packing::PackingParams& p, const grid::Grid<2>& gri
     if (!p.diameters.empty())
       for (const double d : p.diameters) area += std::numbers::pi * 0.25 * d * d;
     else
-      area = static_cast<double>(p.count) * std::numbers::pi * 0.25 * p.diameter_min *
-             p.diameter_min;
+      area =
+          static_cast<double>(p.count) * std::numbers::pi * 0.25 * p.diameter_min * p.diameter_min;
     const double phi = p.method == packing::PackingMethod::kJam ? 1.0 : p.target_phi;
     b0 = Vec<2>(p.origin[0], p.origin[1]);
-    b1 = b0 + Vec<2>(std::sqrt(area / phi * p.aspect_ratio), std::sqrt(area / phi / p.aspect_ratio));
+    b1 =
+        b0 + Vec<2>(std::sqrt(area / phi * p.aspect_ratio), std::sqrt(area / phi / p.aspect_ratio));
   }
   if ((b0.array() < lo.array()).any() || (b1.array() > hi.array()).any())
     throw InputError(g.file, 0, "packing",

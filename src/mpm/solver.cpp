@@ -53,9 +53,9 @@ struct ImplicitSolver<Dim>::GrainWork {
   Eigen::MatrixXd Z;                // A^-1 E: response of all dofs to unit slot impulses [s/kg]
   bool z_forward = false;           // Z holds Y = L^-1 P E instead (LDL^T: grain_compliance)
   bool tangent_current = false, factor_current = false;  // K_blk / factorisation match v
-  bool factor_in_step = false;     // a factorisation of this step's Newton matrix exists
-  std::int64_t factor_count = 0;   // factorisations so far (identifies the current one)
-  std::int64_t z_factor = -1;      // the factorisation Z and G were computed with (-1: none)
+  bool factor_in_step = false;            // a factorisation of this step's Newton matrix exists
+  std::int64_t factor_count = 0;          // factorisations so far (identifies the current one)
+  std::int64_t z_factor = -1;             // the factorisation Z and G were computed with (-1: none)
   double vel_ref = 0;                     // velocity scale of the increment test [sqrt(kg) m/s]
   bool evaluated = false;                 // residual evaluated in the current Newton iteration
   std::vector<IVec<Dim>> pt_first;        // per point: first support node (box coordinates)
@@ -897,7 +897,8 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   for (std::size_t g : owned_) {
     const GrainWork& w = *work_[g];
     if (!have_contacts_) break;
-    for (std::size_t a = 0; a < w.P.size(); ++a) stats.contact_work += 0.5 * w.P[a].dot(w.v_n[a] + w.v[a]);
+    for (std::size_t a = 0; a < w.P.size(); ++a)
+      stats.contact_work += 0.5 * w.P[a].dot(w.v_n[a] + w.v[a]);
   }
   // Contact summary: active contacts and the force of the grains on each wall (-P/dt).
   stats.contacts = static_cast<std::int64_t>(problem_.contacts.size());

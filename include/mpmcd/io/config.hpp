@@ -96,8 +96,8 @@ struct SolverSection {
   std::string linear_solver = "ldlt";  ///< "ldlt" (sparse direct), "lu" or "cg" (Jacobi CG)
   double cg_tolerance = 1e-12;         ///< relative residual of the CG solve [-]
   int cg_max_iterations = 1000;        ///< CG iteration limit [-]
-  double flip = 1.0;    ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
-  bool affine = false;  ///< affine P2G with the points' velocity gradients (APIC/TPIC)
+  double flip = 1.0;            ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
+  bool affine = false;          ///< affine P2G with the points' velocity gradients (APIC/TPIC)
   bool modified_newton = true;  ///< reuse the step's first factorisation (modified Newton)
 };
 

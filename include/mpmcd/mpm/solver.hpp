@@ -113,10 +113,10 @@ struct VelocityBC {
 
 /// Outcome of one attempted step.
 struct StepStats {
-  bool converged = false;                ///< all grains converged
-  int iterations = 0;                    ///< Newton iterations (max over grains)
-  std::int64_t linear_solves = 0;        ///< linear solves, summed over grains
-  std::int64_t factorizations = 0;       ///< Newton-matrix factorisations, summed over grains
+  bool converged = false;           ///< all grains converged
+  int iterations = 0;               ///< Newton iterations (max over grains)
+  std::int64_t linear_solves = 0;   ///< linear solves, summed over grains
+  std::int64_t factorizations = 0;  ///< Newton-matrix factorisations, summed over grains
   /// Work of the contact impulses on the grains over the step, sum_I P_I . (v_I^n + v_I^{n+1}) / 2
   /// over every grain node (the exact kinetic-energy change they cause on the grid) [J] (2D: J/m).
   double contact_work = 0;

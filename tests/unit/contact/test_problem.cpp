@@ -185,9 +185,9 @@ contact::Problem<2> pinched_node(double friction) {
     s.node = 0;
     p.slots.push_back(s);
   };
-  slot(1e-3, Vec<2>(0, 0));    // X
+  slot(1e-3, Vec<2>(0, 0));     // X
   slot(1.0, Vec<2>(1.0, 0.1));  // Y, moving +x
-  slot(1.0, Vec<2>(-1.0, 0));  // Z, moving -x
+  slot(1.0, Vec<2>(-1.0, 0));   // Z, moving -x
   const auto contact = [&](int a, int b, Vec<2> n) {
     contact::Contact<2> c;
     c.a = a;
@@ -196,9 +196,9 @@ contact::Problem<2> pinched_node(double friction) {
     c.friction = friction;
     p.contacts.push_back(c);
   };
-  contact(1, 0, Vec<2>(0.86, 0.51));   // Y pushes X
-  contact(2, 0, Vec<2>(-0.89, -0.46)); // Z pushes X
-  contact(1, 2, Vec<2>(0.87, 0.49));   // Y pushes Z
+  contact(1, 0, Vec<2>(0.86, 0.51));    // Y pushes X
+  contact(2, 0, Vec<2>(-0.89, -0.46));  // Z pushes X
+  contact(1, 2, Vec<2>(0.87, 0.49));    // Y pushes Z
   return p;
 }
 }  // namespace

@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -499,8 +499,7 @@ TEST(Cli, CheckRefusesAPackingBoxLargerThanTheGridBeforeTheDem) {
          "material = \"gel\"\n[time]\ndt = 1e-7\nend_time = 5e-7\n[output]\nfolder = \"out\"\n";
   const auto t0 = std::chrono::steady_clock::now();
   const Result c = run("check " + (dir / "run.toml").string());
-  const double secs =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(c.code, 2) << c.output;
   EXPECT_NE(c.output.find("packing box"), std::string::npos) << c.output;
   EXPECT_NE(c.output.find("checked before the DEM runs"), std::string::npos) << c.output;

@@ -253,8 +253,8 @@ TEST(Dynamics, TranslatedBlockStaysUnstrainedAcrossTenCells) {
   // few steps, boundary nodes with little mass): J = 1 and sigma = 0 to 1e-8 with every shape
   // family, with and without the affine P2G (issue 14).
   constexpr double h = 1e-4, V = 0.5;
-  for (const auto shape : {grid::ShapeKind::kLinear, grid::ShapeKind::kUGimp,
-                           grid::ShapeKind::kCpdi})
+  for (const auto shape :
+       {grid::ShapeKind::kLinear, grid::ShapeKind::kUGimp, grid::ShapeKind::kCpdi})
     for (const bool affine : {false, true}) {
       auto model = make_model(h, 20, 20, "neo_hookean", kLambda, kMu, kRho);
       add_box(model, Vec<2>(3.3 * h, 4.1 * h), Vec<2>(7.3 * h, 8.1 * h), 2,
@@ -263,8 +263,7 @@ TEST(Dynamics, TranslatedBlockStaysUnstrainedAcrossTenCells) {
       s.shape = shape;
       s.affine = affine;
       s.residual_tolerance = s.increment_tolerance = 1e-12;
-      mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains,
-                                    model.law_ptrs());
+      mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
       const double dt = 0.37 * h / V;  // 27 steps over 10 cells
       for (int k = 0; k < 27; ++k) {
         solver.set_time(k * dt);
@@ -278,9 +277,10 @@ TEST(Dynamics, TranslatedBlockStaysUnstrainedAcrossTenCells) {
         sig = std::max(sig, model.points.sigma[p].norm() / kMu);
         dv = std::max(dv, (model.points.v[p] - Vec<2>(V, V / 3)).norm() / V);
       }
-      std::printf("  shape %d, affine %d: max |J - 1| = %.2e, max |sigma| / mu = %.2e, max |dv| / V "
-                  "= %.2e\n",
-                  static_cast<int>(shape), affine ? 1 : 0, dJ, sig, dv);
+      std::printf(
+          "  shape %d, affine %d: max |J - 1| = %.2e, max |sigma| / mu = %.2e, max |dv| / V "
+          "= %.2e\n",
+          static_cast<int>(shape), affine ? 1 : 0, dJ, sig, dv);
       EXPECT_LT(dJ, 1e-8);
       EXPECT_LT(sig, 1e-8);
       EXPECT_LT(dv, 1e-8);

@@ -98,8 +98,8 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
       "dissipation / wall work = %.2e, %d steps "
       "redone as half steps, %lld factorisations for %lld solves\n",
       lambda / 1e6, sf, r.worst_J, r.worst_sigma, r.force_error, r.energy_ratio,
-      r.contact_dissipation, r.retries,
-      static_cast<long long>(r.factorizations), static_cast<long long>(r.solves));
+      r.contact_dissipation, r.retries, static_cast<long long>(r.factorizations),
+      static_cast<long long>(r.solves));
   return r;
 }
 
