@@ -825,40 +825,61 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     solver.set_grain_work(std::move(work));
   }
   // Energy ledger (docs/accuracy.md): the work done by each wall on the grains, W_k += -F_k . v_k
-  // dt with F_k the grains' force on wall k over the step, against the change of elastic plus
-  // kinetic energy since t = 0. Contact dissipates D += sum_k W_k(step) - W_c(step), W_c the work
-  // of all contact impulses on the grains (StepStats::contact_work); the remainder is the time
-  // integrator's and the transfers' (P2G/G2P).
+  // dt with F_k the grains' force on wall k over the step, and by the body forces, against the
+  // change of elastic plus kinetic energy since t = 0. What is lost on the way: contact
+  // dissipates D_c += sum_k W_k(step) - W_c(step), W_c the work of all contact impulses on the
+  // grains (StepStats::contact_work); the transfers D_t (StepStats::transfer_loss); the stress
+  // work on the grid not stored as elastic energy, D_i = -sum W_int - (Psi - Psi_0) (plastic
+  // dissipation; for elastic laws, time integration and quadrature). The remainder is the
+  // Newton tolerance's (and prescribed grid velocities' work).
   std::vector<double> wall_work(cfg.walls.size(), 0.0);
-  double energy0 = 0, contact_dissipation = 0;
+  double energy0 = 0, kinetic0 = 0, contact_dissipation = 0, transfer_dissipation = 0;
+  double stress_work = 0, body_work = 0;
   if (restart) {
     wall_work = restart->wall_work;
     energy0 = restart->energy0;
+    kinetic0 = restart->kinetic0;
     contact_dissipation = restart->contact_dissipation;
+    transfer_dissipation = restart->transfer_dissipation;
+    stress_work = restart->stress_work;
+    body_work = restart->body_work;
   } else {
     const auto d0 = mpm::diagnostics(model);  // every rank holds the initial points
     energy0 = d0.elastic + d0.kinetic;
+    kinetic0 = d0.kinetic;
   }
   std::string ledger_header;
   for (const auto& w : cfg.walls) ledger_header += ",wall_" + w.name + "_work";
-  if (!cfg.walls.empty()) ledger_header += ",energy_change,contact_dissipation,energy_unaccounted";
+  if (!cfg.walls.empty())
+    ledger_header +=
+        ",body_work,energy_change,contact_dissipation,transfer_dissipation,internal_dissipation,"
+        "energy_unaccounted";
+  // The ledger's terms from the diagnostics d of the current points: {sum of the walls' work,
+  // E - E0, internal dissipation D_i, remainder}.
+  struct Ledger {
+    double walls, change, internal, rest;
+  };
+  const auto ledger = [&](const mpm::Diagnostics<2>& d) {
+    Ledger l{0, d.elastic + d.kinetic - energy0, 0, 0};
+    for (const double w : wall_work) l.walls += w;
+    l.internal = -stress_work - (d.elastic - (energy0 - kinetic0));
+    l.rest =
+        l.walls + body_work - contact_dissipation - transfer_dissipation - l.internal - l.change;
+    return l;
+  };
   std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
   if (root)
     out_ptr = std::make_unique<Outputs>(
         cfg, summary.output_dir, observer.csv_header() + ledger_header, restart, history_dir);
-  // The ledger's CSV fields: work of each wall, E - E0, the contact dissipation D, and the
-  // remainder E - E0 - sum of the walls' work + D.
+  // The ledger's CSV fields: work of each wall and of the body forces, E - E0, the contact,
+  // transfer and internal dissipations, and the remainder.
   const auto ledger_fields = [&](const mpm::Diagnostics<2>& d) {
     std::string f;
     if (wall_work.empty()) return f;  // the ledger is written by runs with walls
-    double total = 0;
-    for (const double w : wall_work) {
-      f += fmt::format(",{:.12e}", w);
-      total += w;
-    }
-    const double change = d.elastic + d.kinetic - energy0;
-    return f + fmt::format(",{:.12e},{:.12e},{:.12e}", change, contact_dissipation,
-                           change - total + contact_dissipation);
+    for (const double w : wall_work) f += fmt::format(",{:.12e}", w);
+    const Ledger l = ledger(d);
+    return f + fmt::format(",{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", body_work, l.change,
+                           contact_dissipation, transfer_dissipation, l.internal, l.rest);
   };
   const bool stop_active = cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0;
   const auto gather_state = [&](int to) {
@@ -997,6 +1018,10 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     s.wall_work = wall_work;
     s.energy0 = energy0;
     s.contact_dissipation = contact_dissipation;
+    s.kinetic0 = kinetic0;
+    s.transfer_dissipation = transfer_dissipation;
+    s.stress_work = stress_work;
+    s.body_work = body_work;
     const std::string path =
         (fs::path(out.dir()) / checkpoint::file_name(cfg.simulation.name, s.step)).string();
     checkpoint::write(s, path);
@@ -1058,7 +1083,10 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
       wall_work[k] += wk;
       step_work += wk;
     }
-    if (!wall_work.empty()) contact_dissipation += step_work - st.contact_work;
+    contact_dissipation += step_work - st.contact_work;
+    transfer_dissipation += st.transfer_loss;
+    stress_work += st.stress_work;
+    body_work += st.body_work;
     if (comm.size() > 1 && scheme == parallel::Scheme::kPartition && opt.rebalance > 0 &&
         (summary.steps + 1) % 50 == 0) {  // docs/parallel.md: deterministic work weights
       ScopedStage ts(&solver.timers(), "rebalance");
@@ -1165,17 +1193,15 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   }
   if (!wall_work.empty() && comm.size() > 1) gather_state(0);  // collective
   if (!wall_work.empty() && root) {  // the energy balance of the run (docs/accuracy.md)
-    const auto d = mpm::diagnostics(model);
-    double total = 0;
-    for (const double w : wall_work) total += w;
-    const double change = d.elastic + d.kinetic - energy0;
-    const double rest = total - change - contact_dissipation;
-    const auto pct = [&](double x) { return total != 0 ? 100 * x / std::abs(total) : 0.0; };
+    const Ledger l = ledger(mpm::diagnostics(model));
+    const double in = l.walls + body_work;
+    const auto pct = [&](double x) { return in != 0 ? 100 * x / std::abs(in) : 0.0; };
     log().info(
-        "energy: walls did {:.6g} J/m of work, elastic + kinetic changed by {:.6g} J/m, contact "
-        "dissipated {:.6g} J/m ({:.3g} %); unaccounted (time integrator and transfers) {:.6g} "
-        "J/m = {:.3g} % of the work",
-        total, change, contact_dissipation, pct(contact_dissipation), rest, pct(rest));
+        "energy: walls and body forces did {:.6g} J/m of work, elastic + kinetic changed by "
+        "{:.6g} J/m; dissipated by contact {:.3g} %, by the transfers {:.3g} %, in the bulk "
+        "(stress work not stored) {:.3g} %; unaccounted {:.3g} % of the work",
+        in, l.change, pct(contact_dissipation), pct(transfer_dissipation), pct(l.internal),
+        pct(l.rest));
   }
   log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,
              summary.failed_steps, t, summary.wall_seconds, timers);

@@ -266,7 +266,8 @@ std::uint64_t payload_checksum(const State& s) {
   for (auto v : {s.dim}) h = hash_value(v, h);
   for (auto v : {s.step, s.good_since_cut, s.failed_steps, s.newton_iterations, s.csv_rows})
     h = hash_value(v, h);
-  for (auto v : {s.time, s.dt, s.next_vtu, s.next_csv, s.energy0, s.contact_dissipation})
+  for (auto v : {s.time, s.dt, s.next_vtu, s.next_csv, s.energy0, s.contact_dissipation, s.kinetic0,
+                 s.transfer_dissipation, s.stress_work, s.body_work})
     h = hash_value(v, h);
   for (const auto* a : {&s.vtu_times, &s.x, &s.v, &s.L, &s.F, &s.sigma, &s.domain, &s.sigma_zz,
                         &s.mass, &s.volume0, &s.volume, &s.history, &s.grain_half_width,
@@ -340,6 +341,10 @@ void write(const State& s, const std::string& path) {
     w.array("/walls/work", s.wall_work, {s.wall_work.size()});
     w.scalar("/time/energy0", s.energy0);
     w.scalar("/time/contact_dissipation", s.contact_dissipation);
+    w.scalar("/time/kinetic0", s.kinetic0);
+    w.scalar("/time/transfer_dissipation", s.transfer_dissipation);
+    w.scalar("/time/stress_work", s.stress_work);
+    w.scalar("/time/body_work", s.body_work);
     w.group("/parallel");
     w.scalar("/parallel/ranks", s.ranks);
     w.text("/parallel/scheme", s.scheme);
@@ -462,6 +467,10 @@ State read(const std::string& path) {
   s.wall_work = r.array<double>("/walls/work", {s.wall_point.size() / d});
   s.energy0 = r.scalar<double>("/time/energy0");
   s.contact_dissipation = r.scalar<double>("/time/contact_dissipation");
+  s.kinetic0 = r.scalar<double>("/time/kinetic0");
+  s.transfer_dissipation = r.scalar<double>("/time/transfer_dissipation");
+  s.stress_work = r.scalar<double>("/time/stress_work");
+  s.body_work = r.scalar<double>("/time/body_work");
   s.ranks = r.scalar<std::int32_t>("/parallel/ranks");
   s.scheme = r.text("/parallel/scheme");
   s.grain_owner = r.array<std::int32_t>("/parallel/grain_owner", {ng});

@@ -82,6 +82,9 @@ struct ImplicitSolver<Dim>::GrainWork {
   std::string failure;
   bool retryable = true;  // a smaller dt may cure the failure
   std::int64_t fail_point = -1;
+  // Energy ledger terms of the step (StepStats): kinetic energy of the points before the step and
+  // after its G2P, and of the grid field at v^n [J].
+  double kin_points_n = 0, kin_points = 0, kin_grid_n = 0;
 };
 
 template <int Dim>
@@ -316,6 +319,11 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
       if (mk & (1u << d)) w.v_n[a][d] = bcs_[bc_set_[d][n]].value(xn)[d];
   }
   w.v = w.v_n;  // initial guess: zero acceleration
+  // Energy ledger: what the P2G (and the prescribed values) keep of the points' kinetic energy.
+  w.kin_points_n = w.kin_grid_n = 0;
+  for (std::int64_t i = 0; i < np; ++i)
+    w.kin_points_n += 0.5 * points_.mass[gr.begin + i] * points_.v[gr.begin + i].squaredNorm();
+  for (std::size_t a = 0; a < na; ++a) w.kin_grid_n += 0.5 * w.m[a] * w.v_n[a].squaredNorm();
   reset(w.f_int, na, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.f_abs, na, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.P, na, Vec<Dim>(Vec<Dim>::Zero()));
@@ -892,13 +900,25 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.converged = false;
     return stats;
   }
-  // Work of the contact impulses on this rank's grains (the energy ledger, docs/accuracy.md):
-  // M (v - v^n) = dt f + P makes P . (v^n + v)/2 the kinetic energy the impulses add on the grid.
+  // Energy ledger of this rank's grains (docs/accuracy.md). M (v - v^n) = dt f + P times
+  // (v^n + v)/2 splits the grid's kinetic energy change into the work of the contact impulses,
+  // P . (v^n + v)/2, of the internal and of the body forces; the transfers account for the rest
+  // of the points' kinetic energy change.
+  const double theta = settings_.theta;
   for (std::size_t g : owned_) {
     const GrainWork& w = *work_[g];
-    if (!have_contacts_) break;
-    for (std::size_t a = 0; a < w.P.size(); ++a)
-      stats.contact_work += 0.5 * w.P[a].dot(w.v_n[a] + w.v[a]);
+    double kin_grid = 0, work_c = 0, work_int = 0, work_ext = 0;
+    for (std::size_t a = 0; a < w.m.size(); ++a) {
+      const Vec<Dim> vm = 0.5 * (w.v_n[a] + w.v[a]);
+      kin_grid += 0.5 * w.m[a] * w.v[a].squaredNorm();
+      if (have_contacts_) work_c += w.P[a].dot(vm);
+      work_int += ((1.0 - theta) * (w.f_n[a] - w.f_ext[a]) + theta * w.f_int[a]).dot(vm);
+      work_ext += w.f_ext[a].dot(vm);
+    }
+    stats.contact_work += work_c;
+    stats.stress_work += dt * work_int;
+    stats.body_work += dt * work_ext;
+    stats.transfer_loss += (w.kin_points_n - w.kin_grid_n) + (kin_grid - w.kin_points);
   }
   // Contact summary: active contacts and the force of the grains on each wall (-P/dt).
   stats.contacts = static_cast<std::int64_t>(problem_.contacts.size());
@@ -925,9 +945,15 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.iterations = static_cast<int>(-it[0]);
     std::vector<double> f;
     for (const auto& wf : stats.wall_force) f.insert(f.end(), wf.begin(), wf.end());
-    f.push_back(stats.contact_work);
+    const std::size_t k = f.size();
+    for (const double e :
+         {stats.contact_work, stats.transfer_loss, stats.stress_work, stats.body_work})
+      f.push_back(e);
     comm_->sum(f);
-    stats.contact_work = f.back();
+    stats.contact_work = f[k];
+    stats.transfer_loss = f[k + 1];
+    stats.stress_work = f[k + 2];
+    stats.body_work = f[k + 3];
     for (std::size_t k = 0; k < stats.wall_force.size(); ++k)
       for (int d = 0; d < 3; ++d) stats.wall_force[k][d] = f[3 * k + d];
   }
@@ -1545,29 +1571,38 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
 
 template <int Dim>
 template <class S1>
-void ImplicitSolver<Dim>::commit_grain(std::size_t g) {
+typename ImplicitSolver<Dim>::G2P ImplicitSolver<Dim>::g2p_point(const GrainWork& w, std::int64_t p,
+                                                                 std::int64_t i) const {
   constexpr int K = grid::ShapeOf<Dim, S1>::type::K;
-  GrainWork& w = *work_[g];
-  const points::Grain& gr = grains_[g];
   const double alpha = settings_.flip;
+  Vec<Dim> dx = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero(), vpic = Vec<Dim>::Zero();
+  Mat<Dim> grad_v = Mat<Dim>::Zero();
+  for (int a = 0; a < K; ++a) {
+    const std::int32_t n = w.pt_node[i * K + a];
+    if (n < 0) continue;
+    const double N = w.pt_N[i * K + a];
+    dx += N * w.du[n];
+    dv += N * (w.v[n] - w.v_p2g[n]);
+    vpic += N * w.v[n];
+    if (settings_.affine) grad_v += w.v[n] * w.pt_dN[i * K + a].transpose();
+  }
+  // v_p = flip (v_p + sum N dv) + (1 - flip) sum N v (method.md §2).
+  return {dx, alpha * (points_.v[p] + dv) + (1.0 - alpha) * vpic, grad_v};
+}
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::commit_grain(std::size_t g) {
+  const points::Grain& gr = grains_[g];
+  const GrainWork& w = *work_[g];
   for (std::int64_t i = 0; i < gr.size(); ++i) {
     const std::int64_t p = gr.begin + i;
-    Vec<Dim> dx = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero(), vpic = Vec<Dim>::Zero();
-    Mat<Dim> grad_v = Mat<Dim>::Zero();
-    for (int a = 0; a < K; ++a) {
-      const std::int32_t n = w.pt_node[i * K + a];
-      if (n < 0) continue;
-      const double N = w.pt_N[i * K + a];
-      dx += N * w.du[n];
-      dv += N * (w.v[n] - w.v_p2g[n]);
-      vpic += N * w.v[n];
-      grad_v += w.v[n] * w.pt_dN[i * K + a].transpose();
-    }
+    const G2P u = g2p_point<S1>(w, p, i);
     // Velocity gradient at x^{n+1} for the next affine P2G: grad_{x^n} v dF^-1 (Settings::affine).
-    if (settings_.affine) points_.L[p] = grad_v * dF_inv_T_[p].transpose();
-    // G2P: x_p += sum N du; v_p = flip (v_p + sum N dv) + (1 - flip) sum N v (method.md §2).
-    points_.x[p] += dx;
-    points_.v[p] = alpha * (points_.v[p] + dv) + (1.0 - alpha) * vpic;
+    if (settings_.affine) points_.L[p] = u.grad_v * dF_inv_T_[p].transpose();
+    // G2P: x_p += sum N du (method.md §2).
+    points_.x[p] += u.dx;
+    points_.v[p] = u.v;
     points_.F[p] = F_trial_[p];
     points_.sigma[p] = sigma_trial_[p];
     if constexpr (Dim == 2) points_.sigma_zz[p] = sigma_zz_trial_[p];
@@ -1579,19 +1614,16 @@ template <int Dim>
 template <class S1>
 void ImplicitSolver<Dim>::check_next_positions(std::size_t g) {
   using Shape = typename grid::ShapeOf<Dim, S1>::type;
-  constexpr int K = Shape::K;
   GrainWork& w = *work_[g];
   const points::Grain& gr = grains_[g];
   const double h = grid_.cell_size();
   Shape ps;
+  w.kin_points = 0;
   for (std::int64_t i = 0; i < gr.size(); ++i) {
     const std::int64_t p = gr.begin + i;
-    Vec<Dim> dx = Vec<Dim>::Zero();  // as commit_grain: the same sum, the same position
-    for (int a = 0; a < K; ++a) {
-      const std::int32_t n = w.pt_node[i * K + a];
-      if (n >= 0) dx += w.pt_N[i * K + a] * w.du[n];
-    }
-    const Vec<Dim> x = points_.x[p] + dx;
+    const G2P u = g2p_point<S1>(w, p, i);  // as commit_grain: the same position and velocity
+    w.kin_points += 0.5 * points_.mass[p] * u.v.squaredNorm();
+    const Vec<Dim> x = points_.x[p] + u.dx;
     // A domain stretched too far is left to the next step's set-up (a retryable failure there);
     // its position must still lie on the grid.
     const bool off =

@@ -12,7 +12,7 @@
 namespace mpmcd::checkpoint {
 
 /// Layout version of the files this build writes and reads [-].
-inline constexpr std::int32_t kFormatVersion = 5;
+inline constexpr std::int32_t kFormatVersion = 6;
 
 /// FNV-1a 64-bit offset basis (start value of fnv1a) [-].
 inline constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
@@ -67,10 +67,14 @@ struct State {
   std::vector<std::int32_t> warm_b;     ///< grain b [-]
   std::vector<double> warm_impulse;     ///< impulse on b, count x dim [N s] (2D: N s/m)
   // Walls (their position is point + velocity t; stored to check and inspect).
-  std::vector<double> wall_point;  ///< current point of each wall plane, walls x dim [m]
-  std::vector<double> wall_work;   ///< work done by each wall on the grains so far [J] (2D: J/m)
-  double energy0 = 0;              ///< elastic + kinetic energy at t = 0 [J] (2D: J/m)
-  double contact_dissipation = 0;  ///< energy dissipated by contact since t = 0 [J] (2D: J/m)
+  std::vector<double> wall_point;   ///< current point of each wall plane, walls x dim [m]
+  std::vector<double> wall_work;    ///< work done by each wall on the grains so far [J] (2D: J/m)
+  double energy0 = 0;               ///< elastic + kinetic energy at t = 0 [J] (2D: J/m)
+  double contact_dissipation = 0;   ///< energy dissipated by contact since t = 0 [J] (2D: J/m)
+  double kinetic0 = 0;              ///< kinetic energy at t = 0 [J] (2D: J/m)
+  double transfer_dissipation = 0;  ///< kinetic energy lost by P2G and G2P since t = 0 [J]
+  double stress_work = 0;  ///< work of the internal forces on the grid since t = 0 [J] (2D: J/m)
+  double body_work = 0;    ///< work of the body forces on the grid since t = 0 [J] (2D: J/m)
   // Distribution (docs/parallel.md): restored when the rank count and scheme are the same.
   std::int32_t ranks = 1;                 ///< MPI ranks of the writing run [-]
   std::string scheme = "partition";       ///< parallel scheme of the writing run [-]

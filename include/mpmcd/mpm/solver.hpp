@@ -120,6 +120,15 @@ struct StepStats {
   /// Work of the contact impulses on the grains over the step, sum_I P_I . (v_I^n + v_I^{n+1}) / 2
   /// over every grain node (the exact kinetic-energy change they cause on the grid) [J] (2D: J/m).
   double contact_work = 0;
+  /// Kinetic energy the transfers remove over the step (docs/accuracy.md, energy ledger): the
+  /// P2G's, sum_p m_p |v_p^n|^2/2 - sum_I m_I |v_I^n|^2/2, plus the G2P's,
+  /// sum_I m_I |v_I^{n+1}|^2/2 - sum_p m_p |v_p^{n+1}|^2/2, over every grain [J] (2D: J/m).
+  double transfer_loss = 0;
+  /// Work of the internal forces on the grid, dt sum_I [(1 - theta) f_int^n + theta f_int^{n+1}]
+  /// . (v_I^n + v_I^{n+1})/2 (minus the stress power; -(stored energy change) when exact) [J].
+  double stress_work = 0;
+  /// Work of the body forces on the grid, dt sum_I f_ext,I . (v_I^n + v_I^{n+1})/2 [J] (2D: J/m).
+  double body_work = 0;
   std::vector<double> residual_history;  ///< per iteration: max over grains of |R| / reference
   std::string failure;                   ///< why the step failed ("" if converged)
   bool retryable = true;             ///< false if a smaller dt cannot help (a point left the grid)
@@ -238,10 +247,19 @@ class ImplicitSolver {
   void exchange_entries();
   void exchange_requests();
   double update_contacts_distributed(StepStats& stats);
+  // G2P of point p, the i-th of its grain (method.md §2): position increment sum N du, new velocity
+  // flip (v_p + sum N (v - v_p2g)) + (1 - flip) sum N v, and velocity gradient sum v (x) grad N.
+  struct G2P {
+    Vec<Dim> dx, v;
+    Mat<Dim> grad_v;
+  };
+  template <class S1>
+  G2P g2p_point(const GrainWork& w, std::int64_t p, std::int64_t i) const;
   template <class S1>
   void commit_grain(std::size_t g);
   // Fails grain g's step (not retryable) if a point's position after it, x + sum N du, would put
-  // its shape-function support past the grid's edge (the check setup_grain makes at x^n).
+  // its shape-function support past the grid's edge (the check setup_grain makes at x^n); sums
+  // the points' kinetic energy after the G2P for the energy ledger.
   template <class S1>
   void check_next_positions(std::size_t g);
 

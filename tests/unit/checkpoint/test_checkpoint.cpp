@@ -76,6 +76,10 @@ ck::State sample() {
   s.wall_work = {-3.25e-4};
   s.energy0 = 1.5e-5;
   s.contact_dissipation = 2.5e-6;
+  s.kinetic0 = 1.5e-7;
+  s.transfer_dissipation = 3.5e-6;
+  s.stress_work = -4.5e-6;
+  s.body_work = 5.5e-8;
   s.ranks = 2;
   s.scheme = "partition";
   s.grain_owner = {1, 0};
@@ -170,6 +174,10 @@ TEST(Checkpoint, RoundTripIsBitwise) {
   EXPECT_TRUE(same(r.wall_work, s.wall_work));
   EXPECT_EQ(r.energy0, s.energy0);
   EXPECT_EQ(r.contact_dissipation, s.contact_dissipation);
+  EXPECT_EQ(r.kinetic0, s.kinetic0);
+  EXPECT_EQ(r.transfer_dissipation, s.transfer_dissipation);
+  EXPECT_EQ(r.stress_work, s.stress_work);
+  EXPECT_EQ(r.body_work, s.body_work);
   EXPECT_EQ(r.grain, s.grain);
   EXPECT_EQ(r.grain_begin, s.grain_begin);
   EXPECT_EQ(r.grain_end, s.grain_end);

@@ -1,9 +1,9 @@
 // A tiny compaction run by the `mpmcd` binary (compaction.toml: 9 disks, top wall down at 5 m/s,
 // stop at Phi = 0.8; ~3 s) and the observables of docs/observables.md on every CSV row: the
-// identity ln(Vs/Vs0) = ln(Phi/Phi0) + eps of paper eq. (9) to 1e-10, Phi increasing, wall stress
-// zero before the first contact, the stop criterion, Z and the Love-Weber cross-check. Then
-// `mpmcd analyze` on that run, on three synthetic eq. (10) runs overlaid, and on garbage (exit 2);
-// each [stop] criterion at its threshold.
+// identity ln(Vs/Vs0) = ln(Phi/Phi0) + eps of paper eq. (9) to 1e-10, the energy ledger, Phi
+// increasing, wall stress zero before the first contact, the stop criterion, Z and the Love-Weber
+// cross-check. Then `mpmcd analyze` on that run, on three synthetic eq. (10) runs overlaid, and on
+// garbage (exit 2); each [stop] criterion at its threshold.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -65,6 +65,32 @@ void Eq9IdentityHoldsOnEveryRow(const TinyRun& r) {
       "ln(Vs/Vs0) %.4f\n",
       worst, phi.size(), phi.front(), phi.back(), eps.back(), lnvs.back());
   EXPECT_LT(lnvs.back(), 0.0);  // compressible grains lose area (lambda = 3 MPa)
+}
+
+// The energy ledger (docs/accuracy.md) closes on every row: the work of the walls equals the
+// change of elastic plus kinetic energy plus what contact, the transfers and the bulk dissipate,
+// to the Newton tolerance; contact dissipates (frictionless, Moreau-Jean e = 0: never creates).
+void EnergyLedgerClosesOnEveryRow(const TinyRun& r) {
+  const auto &change = r.col("energy_change"), &dc = r.col("contact_dissipation");
+  const auto &dt = r.col("transfer_dissipation"), &di = r.col("internal_dissipation");
+  const auto &rest = r.col("energy_unaccounted"), &body = r.col("body_work");
+  double work = 0, worst = 0;
+  for (std::size_t i = 0; i < change.size(); ++i) {
+    double w = body[i];
+    for (const char* wall : {"bottom", "top", "left", "right"})
+      w += r.col(std::string("wall_") + wall + "_work")[i];
+    work = std::max(work, std::fabs(w));
+    EXPECT_NEAR(rest[i], w - change[i] - dc[i] - dt[i] - di[i], 1e-12 * (1 + std::fabs(w)));
+    EXPECT_GE(dc[i], -1e-9 * std::fabs(w)) << "row " << i;
+    worst = std::max(worst, std::fabs(rest[i]));
+  }
+  ASSERT_GT(work, 0.0);
+  EXPECT_LT(worst, 1e-6 * work);
+  std::printf(
+      "energy ledger: wall work %.4e J/m, stored %.1f %%, contact %.2f %%, transfers %.2f %%, "
+      "bulk %.2f %%, largest remainder %.1e of the work\n",
+      work, 100 * change.back() / work, 100 * dc.back() / work, 100 * dt.back() / work,
+      100 * di.back() / work, worst / work);
 }
 
 void PhiIncreasesAndTheBoxShrinks(const TinyRun& r) {
@@ -367,6 +393,10 @@ TEST(Compaction, TinyRunObservablesAnalysisAndSnapshots) {
   {
     SCOPED_TRACE("Eq9IdentityHoldsOnEveryRow");
     Eq9IdentityHoldsOnEveryRow(r);
+  }
+  {
+    SCOPED_TRACE("EnergyLedgerClosesOnEveryRow");
+    EnergyLedgerClosesOnEveryRow(r);
   }
   {
     SCOPED_TRACE("PhiIncreasesAndTheBoxShrinks");

@@ -22,7 +22,9 @@ struct BlockResult {
   double worst_J = 0, worst_sigma = 0, force_error = 0, energy_ratio = 0;
   int retries = 0;  // steps redone as two half steps, as the app's step controller does
   std::int64_t factorizations = 0, solves = 0;  // summed over the steps
-  double contact_dissipation = 0;  // wall work - work of the contact impulses (ledger) / wall work
+  double contact_dissipation = 0;   // wall work - work of the contact impulses (ledger) / wall work
+  double transfer_dissipation = 0;  // kinetic energy the P2G and G2P remove / wall work
+  double bulk_dissipation = 0;      // (-stress work on the grid - elastic change) / wall work
   bool converged = true;
   std::string failure;
 };
@@ -53,7 +55,7 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
   const double H0 = hi - lo, dt = (1.0 - s_end) * H0 / V / steps;
   const auto d0 = mpm::diagnostics(model);
   BlockResult r;
-  double work = 0, t = 0, force = 0, contact_work = 0;
+  double work = 0, t = 0, force = 0, contact_work = 0, transfer = 0, stress_work = 0;
   // One step of size `step`; a failed step is redone as two half steps (up to 1/16), as the
   // app's controller cuts dt (docs/accuracy.md lists the failures this still meets).
   std::function<bool(double, int)> advance = [&](double step, int depth) {
@@ -70,6 +72,8 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
     solver.commit();
     r.factorizations += st.factorizations;
     contact_work += st.contact_work;
+    transfer += st.transfer_loss;
+    stress_work += st.stress_work;
     r.solves += st.linear_solves;
     t += step;
     force = st.wall_force[1][1];  // force of the grain on the top wall (+y) [N/m]
@@ -92,14 +96,16 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
   const auto d = mpm::diagnostics(model);
   r.energy_ratio = (d.elastic + d.kinetic - d0.elastic - d0.kinetic) / work;
   r.contact_dissipation = (work - contact_work) / work;
+  r.transfer_dissipation = transfer / work;
+  r.bulk_dissipation = (-stress_work - (d.elastic - d0.elastic)) / work;
   std::printf(
       "  lambda %.3g MPa, s = %.3f: max |J - s| = %.2e, max rel. sigma22 error = %.2e, "
       "top force error = %.2e, (elastic + kinetic change) / wall work = %.5f, contact "
-      "dissipation / wall work = %.2e, %d steps "
+      "dissipation / wall work = %.2e, transfers %.2e, bulk %.2e, %d steps "
       "redone as half steps, %lld factorisations for %lld solves\n",
       lambda / 1e6, sf, r.worst_J, r.worst_sigma, r.force_error, r.energy_ratio,
-      r.contact_dissipation, r.retries, static_cast<long long>(r.factorizations),
-      static_cast<long long>(r.solves));
+      r.contact_dissipation, r.transfer_dissipation, r.bulk_dissipation, r.retries,
+      static_cast<long long>(r.factorizations), static_cast<long long>(r.solves));
   return r;
 }
 
@@ -121,6 +127,12 @@ TEST(WallBlock, CpdiAffineFaceWallsKeepTheExactState) {
     // The faces move with the walls: the contacts do the walls' work and dissipate nothing, so
     // the ledger's contact term (StepStats::contact_work) must vanish to round-off.
     EXPECT_LT(std::abs(r.contact_dissipation), 1e-9);
+    // The affine transfers carry the linear velocity field exactly: they lose nothing, and the
+    // ledger closes on the bulk term (the stress work backward Euler does not store).
+    EXPECT_LT(std::abs(r.transfer_dissipation), 1e-9);
+    EXPECT_NEAR(
+        r.energy_ratio + r.contact_dissipation + r.transfer_dissipation + r.bulk_dissipation, 1.0,
+        1e-9);
   }
 }
 
