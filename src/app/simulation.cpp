@@ -893,6 +893,13 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     if (root) out_ptr->restore_contacts(solver);
     log().info("restarted from {} (written by mpmcd {} on {} rank(s)): step {}, t = {:.9g} s",
                opt.restart, restart->mpmcd_version, restart->ranks, summary.steps, t);
+    // The order of the threads' floating-point sums changes with their count (docs/robustness.md).
+    if (restart->threads != omp_get_max_threads())
+      log().warn(
+          "note: the checkpoint was written with {} thread(s) per rank, this run has {}: the run "
+          "goes on, but bitwise equality with an uninterrupted run is promised only with the same "
+          "thread count (-t {})",
+          restart->threads, omp_get_max_threads(), restart->threads);
   }
   mpm::StepStats last;
   auto record = [&](bool force) {
@@ -990,6 +997,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     }
     s.ranks = comm.size();
     s.scheme = parallel::to_string(scheme);
+    s.threads = omp_get_max_threads();
     s.grain_owner.assign(model.grains.size(), 0);
     if (comm.size() > 1)
       for (std::size_t g = 0; g < model.grains.size(); ++g) s.grain_owner[g] = solver.owner()[g];
