@@ -18,6 +18,7 @@
 
 #include "mpmcd/app/compaction_observer.hpp"
 #include "mpmcd/app/progress.hpp"
+#include "mpmcd/app/speed_check.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/load_config.hpp"
@@ -902,12 +903,21 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
           "thread count (-t {})",
           restart->threads, omp_get_max_threads(), restart->threads);
   }
+  // Runs driven faster than the grains can follow (docs/robustness.md): walls at the start,
+  // material points at output times (rank 0 then holds every point), each reported once.
+  if (const auto w = fast_wall_warning(cfg, model)) log().warn("{}", *w);
+  bool fast_points_reported = false;
   mpm::StepStats last;
   auto record = [&](bool force) {
     const double eps = 1e-9 * dt_nominal;
     const bool csv = force || t >= next_csv - eps, vtu = force || t >= next_vtu - eps;
     if (!csv && !vtu) return;
     if (comm.size() > 1) gather_state(0);
+    if (root && !fast_points_reported)
+      if (const auto w = fast_point_warning(cfg, model, t)) {
+        log().warn("{}", *w);
+        fast_points_reported = true;
+      }
     ScopedStage ts(&solver.timers(), "output");
     const auto problem = parallel::gather_contacts(comm, solver.contact_problem(), 0);
     if (csv) {

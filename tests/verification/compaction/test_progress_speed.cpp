@@ -1,6 +1,9 @@
-// Issue 17, item 5, on the tiny compaction (compaction.toml: 9 disks, top wall down at 5 m/s, stop
-// at Phi = 0.8). The progress line follows the criterion that will end the run (the [stop]
-// criterion, or end_time when it comes first) and shows Phi, the top wall stress and Z.
+// Issue 17, items 5 and 8, on the tiny compaction (compaction.toml: 9 disks, top wall down at
+// 5 m/s, stop at Phi = 0.8). The progress line follows the criterion that will end the run (the
+// [stop] criterion, or end_time when it comes first) and shows Phi, the top wall stress and Z; a
+// wall, or a material point, faster than a fraction of the grains' wave speed is reported (the
+// issue's case: a top wall at 80 m/s, c = 77.85 m/s), a normal compaction is not.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -14,6 +17,7 @@
 
 #include "mpmcd/app/progress.hpp"
 #include "mpmcd/app/simulation.hpp"
+#include "mpmcd/app/speed_check.hpp"
 #include "mpmcd/io/load_config.hpp"
 
 #include "../../support/cli_runner.hpp"
@@ -106,6 +110,8 @@ TEST(Progress, FollowsTheStopCriterionAndShowsTheCompactionState) {
   EXPECT_NEAR(std::strtod(last.c_str() + phi + 6, nullptr), 0.8, 0.005) << last;
   EXPECT_NE(last.find("sigma_top = -"), std::string::npos) << last;
   EXPECT_NE(last.find(" Pa  Z = "), std::string::npos) << last;
+  // A normal compaction (wall at 0.064 c) is not reported as too fast.
+  EXPECT_EQ(r.output.find("wave speed"), std::string::npos) << r.output;
 }
 
 // When end_time comes before the [stop] criterion, the progress follows end_time.
@@ -160,4 +166,69 @@ TEST(Progress, EstimatorPicksTheCriterionExpectedFirst) {
   EXPECT_NEAR(e.eta, 30.0, 1e-9);
   EXPECT_EQ(mpmcd::app::format_eta(e.eta), "30 s");
   EXPECT_EQ(mpmcd::app::format_eta(std::nan("")), "?");
+}
+
+// The issue's case: a top wall at 80 m/s, faster than the wave speed c = sqrt((lambda + 2 mu) /
+// rho) = 77.85 m/s, reached Phi = 0.97 silently. Both warnings, once each.
+TEST(Speed, AWallAndPointsFasterThanTheWaveSpeedAreReported) {
+  const fs::path dir = scratch("fast");
+  const std::string text =
+      with(with(tiny_input(), "velocity = [0.0, -5.0]", "velocity = [0.0, -80.0]"),
+           "end_time = 4e-4", "end_time = 6e-6");
+  const Result r =
+      run("run -t 1 " + write_case(dir, text).string() + " -o " + (dir / "out").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto wall = r.output.find("[W] wall 'top' at 80 m/s (1.03 c) moves faster than 0.1 of");
+  ASSERT_NE(wall, std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("c = sqrt((lambda + 2 mu)/rho) = 77.85 m/s (material 'gel')"),
+            std::string::npos)
+      << r.output;
+  const auto point = r.output.find("[W] at t = ");
+  ASSERT_NE(point, std::string::npos) << r.output;
+  const std::string line = r.output.substr(point, r.output.find('\n', point) - point);
+  EXPECT_NE(line.find("material point "), std::string::npos) << line;
+  EXPECT_NE(line.find(" of grain "), std::string::npos) << line;
+  EXPECT_NE(line.find("of its material 'gel'"), std::string::npos) << line;
+  EXPECT_EQ(r.output.find("[W] wall", wall + 1), std::string::npos) << "reported twice";
+  EXPECT_EQ(r.output.find("material point", point + line.size()), std::string::npos)
+      << "reported twice";
+}
+
+// The thresholds: walls above kFastWallFraction c, points above kFastPointFraction c of their
+// grain's material.
+TEST(Speed, ThresholdsOfWallsAndPoints) {
+  const std::string path = std::string(MPMCD_TEST_DIR) + "/compaction.toml";
+  const double c = std::sqrt(6e6 / 990.0);
+  EXPECT_NEAR(c, 77.85, 0.01);
+  const auto config_with_top = [&](double v) {
+    return mpmcd::io::parse_config(with(tiny_input(), "velocity = [0.0, -5.0]",
+                                        "velocity = [0.0, -" + std::to_string(v) + "]"),
+                                   path);
+  };
+  {
+    const auto cfg = config_with_top(0.99 * mpmcd::app::kFastWallFraction * c);
+    const auto model = mpmcd::app::build_model(cfg);
+    ASSERT_EQ(mpmcd::app::wave_speeds(model).size(), 1u);
+    EXPECT_NEAR(mpmcd::app::wave_speeds(model)[0], c, 1e-9);
+    EXPECT_FALSE(mpmcd::app::fast_wall_warning(cfg, model).has_value());
+  }
+  {
+    const auto cfg = config_with_top(1.01 * mpmcd::app::kFastWallFraction * c);
+    const auto w = mpmcd::app::fast_wall_warning(cfg, mpmcd::app::build_model(cfg));
+    ASSERT_TRUE(w.has_value());
+    EXPECT_NE(w->find("wall 'top' at 7.86 m/s (0.101 c)"), std::string::npos) << *w;
+  }
+  const auto cfg = config_with_top(5.0);
+  auto model = mpmcd::app::build_model(cfg);
+  EXPECT_FALSE(mpmcd::app::fast_point_warning(cfg, model, 0.0).has_value());
+  model.points.v[100] = mpmcd::Vec<2>(0.0, -0.99 * mpmcd::app::kFastPointFraction * c);
+  EXPECT_FALSE(mpmcd::app::fast_point_warning(cfg, model, 0.0).has_value());
+  model.points.v[200] = mpmcd::Vec<2>(1.01 * mpmcd::app::kFastPointFraction * c, 0.0);
+  const auto w = mpmcd::app::fast_point_warning(cfg, model, 1e-5);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_NE(w->find(fmt::format("at t = 1e-05 s material point 200 of grain {} moves at 39.31 m/s",
+                                model.points.grain[200])),
+            std::string::npos)
+      << *w;
+  EXPECT_NE(w->find("(1 point(s) faster than 0.5 c)"), std::string::npos) << *w;
 }
