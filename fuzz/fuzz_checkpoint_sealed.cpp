@@ -16,13 +16,10 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string path = "/tmp/mpmcd_fuzz_sealed_" + std::to_string(getpid()) + ".h5";
   const std::string_view body(reinterpret_cast<const char*>(data), size);
-  char head[512] = {};
-  std::snprintf(head, sizeof head, "MPMCD-CHECKPOINT %d\nbytes %zu\nfnv1a64 %016llx\n",
-                mpmcd::checkpoint::kFormatVersion, size,
-                static_cast<unsigned long long>(mpmcd::checkpoint::fnv1a(body)));
+  const std::string head = mpmcd::checkpoint::header_for(body);
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) return 0;
-  std::fwrite(head, 1, sizeof head, f);
+  std::fwrite(head.data(), 1, head.size(), f);
   std::fwrite(data, 1, size, f);
   std::fclose(f);
   try {

@@ -111,6 +111,28 @@ std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm
   return out;
 }
 
+std::optional<CompactionObserver::Now> CompactionObserver::now(double grain_area,
+                                                               const mpm::StepStats& step,
+                                                               double t) const {
+  if (!box_) return std::nullopt;
+  const analysis::Box box = analysis::box_at(walls_, *box_, t);
+  const auto s = analysis::compaction_state(box, box0_, grain_area, vs0_);
+  const auto stress = [&](std::size_t k) {
+    return analysis::wall_normal_stress(force_on(step, k), walls_[k].normal,
+                                        analysis::wall_length(box, *box_, k));
+  };
+  return Now{s.phi, std::fabs(s.strain), stress(box_->bottom), stress(box_->top)};
+}
+
+double CompactionObserver::initial_phi() const {
+  return box_ && box0_.area() > 0 ? vs0_ / box0_.area() : 0.0;
+}
+
+std::optional<double> CompactionObserver::coordination(const contact::Problem<2>& problem) const {
+  if (!contact_) return std::nullopt;
+  return analysis::coordination(analysis::contact_impulses(problem), grains_).z;
+}
+
 std::vector<double> CompactionObserver::grain_areas(const mpm::Model<2>& model,
                                                     const std::vector<int>* owner, int rank) {
   return per_grain_sums(model, model.points.volume, owner, rank);

@@ -17,6 +17,8 @@
 #include <regex>
 
 #include "mpmcd/app/compaction_observer.hpp"
+#include "mpmcd/app/progress.hpp"
+#include "mpmcd/app/speed_check.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/load_config.hpp"
@@ -914,13 +916,29 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     if (root) out_ptr->restore_contacts(solver);
     log().info("restarted from {} (written by mpmcd {} on {} rank(s)): step {}, t = {:.9g} s",
                opt.restart, restart->mpmcd_version, restart->ranks, summary.steps, t);
+    // The order of the threads' floating-point sums changes with their count (docs/robustness.md).
+    if (restart->threads != omp_get_max_threads())
+      log().warn(
+          "note: the checkpoint was written with {} thread(s) per rank, this run has {}: the run "
+          "goes on, but bitwise equality with an uninterrupted run is promised only with the same "
+          "thread count (-t {})",
+          restart->threads, omp_get_max_threads(), restart->threads);
   }
+  // Runs driven faster than the grains can follow (docs/robustness.md): walls at the start,
+  // material points at output times (rank 0 then holds every point), each reported once.
+  if (const auto w = fast_wall_warning(cfg, model)) log().warn("{}", *w);
+  bool fast_points_reported = false;
   mpm::StepStats last;
   auto record = [&](bool force) {
     const double eps = 1e-9 * dt_nominal;
     const bool csv = force || t >= next_csv - eps, vtu = force || t >= next_vtu - eps;
     if (!csv && !vtu) return;
     if (comm.size() > 1) gather_state(0);
+    if (root && !fast_points_reported)
+      if (const auto w = fast_point_warning(cfg, model, t)) {
+        log().warn("{}", *w);
+        fast_points_reported = true;
+      }
     ScopedStage ts(&solver.timers(), "output");
     const auto problem = parallel::gather_contacts(comm, solver.contact_problem(), 0);
     if (csv) {
@@ -1011,6 +1029,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     }
     s.ranks = comm.size();
     s.scheme = parallel::to_string(scheme);
+    s.threads = omp_get_max_threads();
     s.grain_owner.assign(model.grains.size(), 0);
     if (comm.size() > 1)
       for (std::size_t g = 0; g < model.grains.size(); ++g) s.grain_owner[g] = solver.owner()[g];
@@ -1035,6 +1054,22 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   const auto wall0 = std::chrono::steady_clock::now();
   auto last_progress = wall0, last_checkpoint_wall = wall0;
   const std::int64_t steps0 = summary.steps;
+  // Progress toward the criterion that will end the run (docs/robustness.md, "Progress"): the
+  // compaction state of the committed step (collective: the grains' area is summed over ranks).
+  ProgressEstimator progress(t_end, cfg.stop, observer.initial_phi());
+  const auto progress_sample = [&](const mpm::StepStats& st, double wall) {
+    ProgressSample s{wall, t, std::nullopt, std::nullopt, std::nullopt};
+    if (!observer.has_box()) return std::make_pair(s, std::optional<CompactionObserver::Now>());
+    std::vector<double> areas = CompactionObserver::grain_areas(
+        model, comm.size() > 1 ? &solver.owner() : nullptr, comm.rank());
+    if (comm.size() > 1) comm.sum(areas);
+    const auto now = observer.now(CompactionObserver::total_area(areas), st, t);
+    s.phi = now->phi;
+    s.strain = now->strain;
+    if (!st.wall_force.empty()) s.stress = -now->bottom_stress;  // none before the first step
+    return std::make_pair(s, now);
+  };
+  if (!opt.quiet) progress.add(progress_sample(last, 0.0).first);
   while (t < t_end - 1e-9 * dt_nominal) {
     const double dt_try = std::min(dt, t_end - t);
     solver.set_time(t);
@@ -1139,10 +1174,14 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                 std::chrono::duration<double>(now - last_checkpoint_wall).count() >=
                     60.0 * cfg.checkpoint.every_minutes
             ? 1.0
+            : 0.0,
+        !opt.quiet && std::chrono::duration<double>(now - last_progress).count() >=
+                          cfg.output.progress_interval
+            ? 1.0
             : 0.0};
     if (comm.size() > 1) comm.max(flags);
     const int signal = static_cast<int>(flags[0]);
-    const bool due_wall = flags[1] > 0;
+    const bool due_wall = flags[1] > 0, due_progress = flags[2] > 0;
     if ((signal != 0 || stop) && !at_end) {
       summary.signal = signal;
       summary.interrupted = true;
@@ -1153,14 +1192,29 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
       write_checkpoint("periodic");
       last_checkpoint_wall = now;
     }
-    if (std::chrono::duration<double>(now - last_progress).count() >=
-        cfg.output.progress_interval) {
+    if (due_progress) {  // the same step on every rank: the sample is collective
       last_progress = now;
       const double wall = std::chrono::duration<double>(now - wall0).count();
-      const double rate = static_cast<double>(summary.steps - steps0) / wall;
-      const double eta = (t_end - t) / dt_nominal / std::max(rate, 1e-30);
-      log().info("step {:>7}  t = {:.6e} s ({:5.1f}%)  newton {}  {:.1f} steps/s  ETA {:.0f} s",
-                 summary.steps, t, 100 * t / t_end, st.iterations, rate, eta);
+      const auto [sample, state] = progress_sample(st, wall);
+      progress.add(sample);
+      std::optional<double> z;
+      if (settings.contact.enabled)
+        z = observer.coordination(parallel::gather_contacts(comm, solver.contact_problem(), 0));
+      const auto e = progress.estimate();
+      std::string observed;
+      if (state)
+        observed =
+            fmt::format("  Phi = {:.4f}  sigma_top = {:.4g} Pa", state->phi, state->top_stress);
+      if (z) observed += fmt::format("  Z = {:.3f}", *z);
+      const double rate = static_cast<double>(summary.steps - steps0) / std::max(wall, 1e-30);
+      log().info(
+          "step {:>7}  t = {:.6e} s ({:5.1f}% of {} = {:.6g}{}){}  newton {}  {:.1f} steps/s  "
+          "ETA {}",
+          summary.steps, t, 100 * e.fraction, e.criterion, e.target,
+          e.criterion == "end_time"      ? " s"
+          : e.criterion == "stop.stress" ? " Pa"
+                                         : "",
+          observed, st.iterations, rate, format_eta(e.eta));
     }
   }
   if (!summary.interrupted && cfg.checkpoint.at_end && last_checkpoint_step != summary.steps)

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -23,7 +24,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::size_t kUserBlock = 512;  // bytes before the HDF5 superblock (power of 2 >= 512)
+constexpr std::size_t kUserBlock = kHeaderBytes;  // before the HDF5 superblock (power of 2 >= 512)
+static_assert(kUserBlock >= 512 && (kUserBlock & (kUserBlock - 1)) == 0);
 constexpr std::string_view kMagic = "MPMCD-CHECKPOINT";
 
 // ---------------------------------------------------------------------------------------------
@@ -152,10 +154,9 @@ class Writer {
   Handle file_;
 };
 
-// Checksum of the bytes of `path` from `offset` to the end.
-std::uint64_t file_checksum(std::FILE* f, std::size_t offset, std::size_t& bytes) {
+// FNV-1a of the bytes of `f` from `offset` to the end, continuing from `h`.
+std::uint64_t file_checksum(std::FILE* f, std::size_t offset, std::size_t& bytes, std::uint64_t h) {
   std::vector<char> buf(1 << 20);
-  std::uint64_t h = kFnvOffset;
   bytes = 0;
   if (std::fseek(f, static_cast<long>(offset), SEEK_SET) != 0) return 0;
   std::size_t n;
@@ -166,9 +167,16 @@ std::uint64_t file_checksum(std::FILE* f, std::size_t offset, std::size_t& bytes
   return h;
 }
 
+// The header block: text padded with NUL bytes to kUserBlock.
 std::string header_text(std::size_t bytes, std::uint64_t sum) {
-  return fmt::format("{} {}\nbytes {}\nfnv1a64 {:016x}\n", kMagic, kFormatVersion, bytes, sum);
+  std::string h =
+      fmt::format("{} {}\nbytes {}\nfnv1a64 {:016x}\n", kMagic, kFormatVersion, bytes, sum);
+  h.resize(kUserBlock, '\0');
+  return h;
 }
+
+constexpr std::string_view kSumKey = "\nfnv1a64 ";
+constexpr std::size_t kSumDigits = 16;
 
 void fsync_path(const std::string& path, int flags) {
   const int fd = ::open(path.c_str(), flags);
@@ -277,6 +285,7 @@ std::uint64_t payload_checksum(const State& s) {
     h = hash_array(*a, h);
   h = hash_value(s.ranks, h);
   h = fnv1a(s.scheme, h);
+  h = hash_value(s.threads, h);
   for (const auto* a : {&s.grain_begin, &s.grain_end, &s.grain_history_offset, &s.warm_node})
     h = hash_array(*a, h);
   return h;
@@ -350,16 +359,22 @@ void write(const State& s, const std::string& path) {
     w.text("/parallel/scheme", s.scheme);
     w.array("/parallel/grain_owner", s.grain_owner, {ng});
     w.array("/parallel/grain_work", s.grain_work, {ng, parallel::kWorkPhases});
+    w.scalar("/parallel/threads", s.threads);
     w.close();
   }
-  // The user block: header with the size and checksum of everything after it.
+  // The user block: header with the size of the HDF5 part and the checksum of the whole file,
+  // the header's own digits read as zeros.
+  std::error_code size_ec;
+  const auto file_size = fs::file_size(tmp, size_ec);
+  if (size_ec || file_size < kUserBlock)
+    throw std::runtime_error(fmt::format("cannot write checkpoint '{}' (size)", tmp));
+  const std::size_t body = static_cast<std::size_t>(file_size) - kUserBlock;
   std::FILE* f = std::fopen(tmp.c_str(), "r+b");
   if (!f) throw std::runtime_error(fmt::format("cannot reopen checkpoint '{}'", tmp));
   std::size_t bytes = 0;
-  const std::uint64_t sum = file_checksum(f, kUserBlock, bytes);
-  std::string header = header_text(bytes, sum);
-  header.resize(kUserBlock, '\0');
-  const bool ok = std::fseek(f, 0, SEEK_SET) == 0 &&
+  const std::uint64_t sum = file_checksum(f, kUserBlock, bytes, fnv1a(header_text(body, 0)));
+  const std::string header = header_text(bytes, sum);
+  const bool ok = bytes == body && std::fseek(f, 0, SEEK_SET) == 0 &&
                   std::fwrite(header.data(), 1, header.size(), f) == header.size() &&
                   std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
   std::fclose(f);
@@ -380,28 +395,42 @@ State read(const std::string& path) {
   };
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw refuse("no such file");
-  // 1. Header, size and checksum before libhdf5 sees the file.
+  // 1. Header, size and checksum before libhdf5 sees the file. The checksum covers every byte of
+  // the file: the header block (text and NUL padding) with its 16 digits read as '0', then the
+  // HDF5 part.
   std::size_t file_bytes = 0;
   {
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) throw refuse("cannot open the file");
     std::array<char, kUserBlock> block{};
     const std::size_t got = std::fread(block.data(), 1, block.size(), f);
-    std::size_t bytes = 0;
-    const std::uint64_t sum = got == block.size() ? file_checksum(f, kUserBlock, bytes) : 0;
-    std::fclose(f);
-    if (got != block.size()) throw refuse("shorter than its 512-byte header (truncated?)");
+    const auto fail = [&](const std::string& what) {
+      std::fclose(f);
+      return refuse(what);
+    };
+    if (got != block.size()) throw fail("shorter than its 512-byte header (truncated?)");
     const std::string head(block.data(), strnlen(block.data(), block.size()));
     if (head.rfind(kMagic, 0) != 0)
-      throw refuse("not an mpmcd checkpoint (no MPMCD-CHECKPOINT header)");
+      throw fail("not an mpmcd checkpoint (no MPMCD-CHECKPOINT header)");
     int version = 0;
     unsigned long long want_bytes = 0, want_sum = 0;
     if (std::sscanf(head.c_str(), "MPMCD-CHECKPOINT %d\nbytes %llu\nfnv1a64 %llx", &version,
                     &want_bytes, &want_sum) != 3)
-      throw refuse("unreadable header");
+      throw fail("unreadable header");
     if (version != kFormatVersion)
-      throw refuse(
+      throw fail(
           fmt::format("format version {}, this mpmcd reads version {}", version, kFormatVersion));
+    const std::size_t digits = head.find(kSumKey);
+    if (digits == std::string::npos || digits + kSumKey.size() + kSumDigits > head.size() ||
+        !std::all_of(head.begin() + static_cast<long>(digits + kSumKey.size()),
+                     head.begin() + static_cast<long>(digits + kSumKey.size() + kSumDigits),
+                     [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) != 0; }))
+      throw fail("unreadable header (checksum digits)");
+    std::string zeroed(block.data(), block.size());
+    zeroed.replace(digits + kSumKey.size(), kSumDigits, kSumDigits, '0');
+    std::size_t bytes = 0;
+    const std::uint64_t sum = file_checksum(f, kUserBlock, bytes, fnv1a(zeroed));
+    std::fclose(f);
     if (bytes != want_bytes)
       throw refuse(
           fmt::format("the file holds {} bytes after its header, its header says {} "
@@ -475,6 +504,7 @@ State read(const std::string& path) {
   s.scheme = r.text("/parallel/scheme");
   s.grain_owner = r.array<std::int32_t>("/parallel/grain_owner", {ng});
   s.grain_work = r.array<double>("/parallel/grain_work", {ng, parallel::kWorkPhases});
+  s.threads = r.scalar<std::int32_t>("/parallel/threads");
   // 3. Consistency and the payload checksum.
   if (r.scalar<std::uint64_t>("/meta/payload_checksum") != payload_checksum(s))
     r.fail("/meta/payload_checksum", "payload checksum mismatch (corrupted data)");
@@ -496,6 +526,7 @@ State read(const std::string& path) {
   if (expect_begin != static_cast<std::int64_t>(n))
     r.fail("/grains", "the grains do not cover every point");
   if (s.ranks < 1) r.fail("/parallel/ranks", fmt::format("{} ranks", s.ranks));
+  if (s.threads < 1) r.fail("/parallel/threads", fmt::format("{} threads", s.threads));
   if (s.scheme != "partition" && s.scheme != "master")
     r.fail("/parallel/scheme", fmt::format("unknown scheme '{}'", s.scheme));
   for (std::size_t g = 0; g < ng; ++g) {
@@ -506,6 +537,11 @@ State read(const std::string& path) {
                                       s.grain_owner[g], s.ranks));
   }
   return s;
+}
+
+std::string header_for(std::string_view body) {
+  const std::uint64_t sum = fnv1a(body, fnv1a(header_text(body.size(), 0)));
+  return header_text(body.size(), sum);
 }
 
 std::string file_name(const std::string& name, std::int64_t step) {

@@ -38,6 +38,21 @@ class CompactionObserver {
   std::optional<std::string> stop_reason(double grain_area, const mpm::StepStats& step,
                                          double t) const;
 
+  /// What the progress line shows of the committed state at time t [s].
+  struct Now {
+    double phi = 0;            ///< solid fraction Φ = Vs/V [-]
+    double strain = 0;         ///< |ε| = |ln(h/h0)| [-]
+    double bottom_stress = 0;  ///< normal stress on the bottom wall (compression < 0) [Pa]
+    double top_stress = 0;     ///< normal stress on the top wall (compression < 0) [Pa]
+  };
+  /// Φ, |ε| and the bottom and top wall stresses with the grains' area `grain_area` [m^2] (as in
+  /// stop_reason); nullopt when the walls do not form a box.
+  std::optional<Now> now(double grain_area, const mpm::StepStats& step, double t) const;
+  /// Solid fraction Φ0 at t = 0 (V_s0 over the initial box) [-]; 0 without a box.
+  double initial_phi() const;
+  /// Coordination number Z of the contact network of `problem` [-]; nullopt without contact.
+  std::optional<double> coordination(const contact::Problem<2>& problem) const;
+
   /// Current area of each grain, sum of its points' V_p [m^2]; with `owner`, only the grains
   /// with owner[g] == rank (0 for the others).
   static std::vector<double> grain_areas(const mpm::Model<2>& model,

@@ -2,8 +2,9 @@
 /// Checkpoint files (HDF5, docs/robustness.md): everything a run needs to continue bitwise, as
 /// plain arrays. Written atomically (temporary file, fsync, rename); the first 512 bytes of the
 /// file are an HDF5 user block holding a text header with the file size and an FNV-1a checksum of
-/// the rest, verified before libhdf5 parses anything, so a truncated or corrupted file is refused
-/// with an InputError and never loaded.
+/// the whole file (header and its padding included), verified before libhdf5 parses anything, so
+/// a truncated or corrupted file is refused with an InputError and never loaded.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -13,6 +14,9 @@ namespace mpmcd::checkpoint {
 
 /// Layout version of the files this build writes and reads [-].
 inline constexpr std::int32_t kFormatVersion = 6;
+
+/// Size of the text header (HDF5 user block) before the HDF5 data [bytes].
+inline constexpr std::size_t kHeaderBytes = 512;
 
 /// FNV-1a 64-bit offset basis (start value of fnv1a) [-].
 inline constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
@@ -78,6 +82,7 @@ struct State {
   // Distribution (docs/parallel.md): restored when the rank count and scheme are the same.
   std::int32_t ranks = 1;                 ///< MPI ranks of the writing run [-]
   std::string scheme = "partition";       ///< parallel scheme of the writing run [-]
+  std::int32_t threads = 1;               ///< OpenMP threads per rank of the writing run [-]
   std::vector<std::int32_t> grain_owner;  ///< rank owning each grain, per grain [-]
   /// Re-balancing work since the last check, grain x parallel::kWorkPhases (grain-major) [-].
   std::vector<double> grain_work;
@@ -85,6 +90,13 @@ struct State {
   /// Number of material points [-].
   std::size_t points() const { return grain.size(); }
 };
+
+/// The kHeaderBytes-byte header of a checkpoint whose HDF5 part (everything after the header) is
+/// `body`: "MPMCD-CHECKPOINT <version>\nbytes <body size>\nfnv1a64 <16 hex digits>\n" padded
+/// with NUL bytes, the digits being the FNV-1a hash of the whole file (this header, padding
+/// included, with the 16 digits read as '0', then `body`) [-]. For tests and fuzzing: write()
+/// seals its files so.
+std::string header_for(std::string_view body);
 
 /// Checksum of the payload (every array and counter, in a fixed order, native bytes) [-].
 std::uint64_t payload_checksum(const State& state);

@@ -82,6 +82,7 @@ ck::State sample() {
   s.body_work = 5.5e-8;
   s.ranks = 2;
   s.scheme = "partition";
+  s.threads = 3;
   s.grain_owner = {1, 0};
   s.grain_work = {3.0 * 4, 0.5, 0, 1, 2, 3, 4, 5};
   return s;
@@ -121,13 +122,8 @@ void write_sealed(const fs::path& path, const std::function<void(hid_t)>& fill) 
   fill(f);
   H5Fclose(f);
   H5Pclose(fcpl);
-  std::string bytes = read_bytes(path);
-  const std::string rest = bytes.substr(512);
-  char head[512] = {};
-  std::snprintf(head, sizeof head, "MPMCD-CHECKPOINT %d\nbytes %zu\nfnv1a64 %016llx\n",
-                ck::kFormatVersion, rest.size(), static_cast<unsigned long long>(ck::fnv1a(rest)));
-  bytes.replace(0, 512, std::string(head, 512));
-  write_bytes(path, bytes);
+  const std::string rest = read_bytes(path).substr(512);
+  write_bytes(path, ck::header_for(rest) + rest);
 }
 
 }  // namespace
@@ -188,6 +184,7 @@ TEST(Checkpoint, RoundTripIsBitwise) {
   EXPECT_EQ(r.warm_b, s.warm_b);
   EXPECT_EQ(r.ranks, s.ranks);
   EXPECT_EQ(r.scheme, s.scheme);
+  EXPECT_EQ(r.threads, 3);
   EXPECT_EQ(r.grain_owner, s.grain_owner);
   EXPECT_TRUE(same(r.grain_work, s.grain_work));
   EXPECT_EQ(ck::payload_checksum(r), ck::payload_checksum(s));
@@ -228,6 +225,25 @@ TEST(Checkpoint, CorruptedBytesAreRefused) {
     write_bytes(p, bad);
     SCOPED_TRACE(at);
     expect_refused(p, "checksum mismatch");
+  }
+  // Issue 17: the header block is in the checksum too, its NUL padding included (a flipped bit
+  // there was accepted), and so are its text lines.
+  const std::size_t text = bytes.find('\0');
+  ASSERT_LT(text, std::size_t{200});
+  for (const std::size_t at : {text, std::size_t{300}, std::size_t{511}}) {
+    std::string bad = bytes;
+    bad[at] = static_cast<char>(bad[at] ^ 0x01);
+    const fs::path p = dir / ("padding_" + std::to_string(at) + ".h5");
+    write_bytes(p, bad);
+    SCOPED_TRACE(at);
+    expect_refused(p, "checksum mismatch");
+  }
+  {
+    std::string bad = bytes;
+    bad.replace(bytes.find("bytes ") + 6, 0, "0");  // the same size with a leading zero
+    bad.erase(text + 1, 1);                         // (keeps the block 512 bytes long)
+    write_bytes(dir / "size_text.h5", bad);
+    expect_refused(dir / "size_text.h5", "checksum mismatch");
   }
   // A damaged header.
   std::string bad = bytes;
@@ -355,12 +371,8 @@ TEST(Checkpoint, ResealedFuzzFindingsAreRefused) {
     if (e.path().stem() == "huge_allocation") continue;
 #endif
     const std::string body = read_bytes(e.path());
-    char head[512] = {};
-    std::snprintf(head, sizeof head, "MPMCD-CHECKPOINT %d\nbytes %zu\nfnv1a64 %016llx\n",
-                  ck::kFormatVersion, body.size(),
-                  static_cast<unsigned long long>(ck::fnv1a(body)));
     const fs::path p = dir / (e.path().stem().string() + ".h5");
-    write_bytes(p, std::string(head, sizeof head) + body);
+    write_bytes(p, ck::header_for(body) + body);
     SCOPED_TRACE(e.path().filename().string());
     expect_refused(p, "checkpoint refused");
     ++files;

@@ -275,9 +275,15 @@ TEST(Restart, DamagedCheckpointOrForeignInputExits2) {
   flipped[bytes.size() / 2] = static_cast<char>(flipped[bytes.size() / 2] ^ 1);
   std::ofstream(dir / "flipped.h5", std::ios::binary) << flipped;
   std::ofstream(dir / "empty.h5", std::ios::binary) << "";
+  // Issue 17: a bit flipped in the header's NUL padding (outside the checksum before format 6).
+  std::string padding = bytes;
+  ASSERT_EQ(padding[300], '\0');
+  padding[300] = 1;
+  std::ofstream(dir / "padding.h5", std::ios::binary) << padding;
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"truncated.h5", "truncated"},
       {"flipped.h5", "checksum mismatch"},
+      {"padding.h5", "checksum mismatch"},
       {"empty.h5", "shorter than its 512-byte header"},
       {"absent.h5", "no such file"}};
   for (const auto& [file, fragment] : cases) {
@@ -295,4 +301,29 @@ TEST(Restart, DamagedCheckpointOrForeignInputExits2) {
       << read(dir / "bad.log");
   // Nothing to run.
   EXPECT_EQ(run_binary({"run"}, dir / "bad.log"), 2);
+}
+
+// Issue 17: bitwise equality is promised for the same thread count only; a restart with another
+// one says so (the checkpoint stores the writer's thread count), one with the same does not.
+TEST(Restart, AnotherThreadCountPrintsANote) {
+  const fs::path dir = scratch("threads");
+  const fs::path in = write_case(dir, 8, "");
+  ASSERT_EQ(run_binary({"run", "-q", "-t", "2", in.string(), "--stop-after", "4"}, dir / "a.log"),
+            4)
+      << read(dir / "a.log");
+  const fs::path ckpt = dir / "out" / ck::file_name("pair", 4);
+  EXPECT_EQ(ck::read(ckpt.string()).threads, 2);
+  ASSERT_EQ(run_binary({"run", "-q", "-t", "1", "--restart", ckpt.string()}, dir / "b.log"), 0)
+      << read(dir / "b.log");
+  EXPECT_NE(read(dir / "b.log")
+                .find("note: the checkpoint was written with 2 thread(s) per rank, "
+                      "this run has 1: the run goes on, but bitwise equality with "
+                      "an uninterrupted run is promised only with the same thread "
+                      "count (-t 2)"),
+            std::string::npos)
+      << read(dir / "b.log");
+  EXPECT_EQ(ck::read((dir / "out" / ck::file_name("pair", 8)).string()).threads, 1);
+  ASSERT_EQ(run_binary({"run", "-q", "-t", "2", "--restart", ckpt.string()}, dir / "c.log"), 0)
+      << read(dir / "c.log");
+  EXPECT_EQ(read(dir / "c.log").find("note:"), std::string::npos) << read(dir / "c.log");
 }
