@@ -297,6 +297,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
   c.gs.max_sweeps = cfg.contact.max_sweeps;
   c.gs.relaxation = cfg.contact.relaxation;
   c.gs.relax_after = cfg.contact.relax_after;
+  c.gs.node_blocks = cfg.contact.node_blocks;
   c.impulse_tolerance = cfg.contact.impulse_tolerance;
   c.wall_range = cfg.contact.wall_range;
   c.wall_points = cfg.contact.wall_contact == "points";

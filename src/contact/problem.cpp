@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "mpmcd/core/errors.hpp"
@@ -119,17 +121,21 @@ struct NodeRuns {
 };
 
 template <int Dim>
-NodeRuns node_runs(const Problem<Dim>& p) {
+NodeRuns node_runs(const Problem<Dim>& p, bool node_blocks) {
   NodeRuns runs;
   const auto n = static_cast<std::int32_t>(p.contacts.size());
   runs.order.resize(static_cast<std::size_t>(n));
   for (std::int32_t c = 0; c < n; ++c) runs.order[c] = c;
   runs.start.push_back(0);
+  const auto node = [&](std::int32_t c) { return p.slots[p.contacts[c].b].node; };
   if (!p.groups.empty()) {
+    // One run; with node blocks, its contacts ordered by node so that each node's are adjacent.
+    if (node_blocks)
+      std::stable_sort(runs.order.begin(), runs.order.end(),
+                       [&](std::int32_t x, std::int32_t y) { return node(x) < node(y); });
     runs.start.push_back(n);
     return runs;
   }
-  const auto node = [&](std::int32_t c) { return p.slots[p.contacts[c].b].node; };
   std::stable_sort(runs.order.begin(), runs.order.end(),
                    [&](std::int32_t x, std::int32_t y) { return node(x) < node(y); });
   for (std::int32_t k = 1; k < n; ++k)
@@ -155,14 +161,117 @@ Vec<Dim> project_cone(const Vec<Dim>& P, const Vec<Dim>& n, double mu) {
   return qn * n + (ptn > 0 ? (mu * qn / ptn) * pt : Vec<Dim>(Vec<Dim>::Zero()));
 }
 
+// Response block of slot s's velocity to an impulse on slot t: I/m or G_st within one group, 0
+// between slots of different groups (or walls, t < 0).
+template <int Dim>
+Mat<Dim> cross_block(const Problem<Dim>& p, std::int32_t s, std::int32_t t) {
+  if (s < 0 || t < 0) return Mat<Dim>::Zero();
+  if (s == t) return self_block(p, s);
+  const Slot<Dim>&ss = p.slots[s], &st = p.slots[t];
+  if (ss.group < 0 || ss.group != st.group) return Mat<Dim>::Zero();
+  return p.groups[ss.group].G.template block<Dim, Dim>(Dim * ss.local, Dim * st.local);
+}
+
+// Largest node block solved exactly (2^k active sets).
+constexpr int kMaxBlock = 6;
+
+// Exact solution of the k frictionless contacts idx[0..k) of one node together (the nodal block,
+// GsSettings::node_blocks): with the other impulses fixed, the linear complementarity problem
+// p >= 0, w = u + W (p - p0) >= 0, p . w = 0 over their normal impulses, u_c the current normal
+// relative velocity plus g/dt and W_cd = n_c . (response of contact c to a unit impulse of d)
+// (method.md §4), solved by trying the active sets in turn with a minimum-norm solve (the node's
+// contacts may be redundant: a light field pinched between two grains). Returns false, leaving
+// the impulses unchanged, when a contact has friction, k is out of range or no set fits.
+template <int Dim>
+bool solve_node_block(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const std::int32_t* idx, int k) {
+  if (k < 2 || k > kMaxBlock) return false;
+  using MatK = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxBlock, kMaxBlock>;
+  using VecK = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxBlock, 1>;
+  MatK W(k, k);
+  VecK u(k), p0(k);
+  for (int i = 0; i < k; ++i) {
+    const Contact<Dim>& c = p.contacts[idx[i]];
+    if (c.friction != 0.0) return false;
+    const Vec<Dim> va = c.a >= 0 ? v[c.a] : c.wall_velocity;
+    u[i] = c.normal.dot(v[c.b] - va) + c.gap / p.dt;
+    p0[i] = c.impulse.dot(c.normal);
+    for (int j = 0; j < k; ++j) {
+      const Contact<Dim>& d = p.contacts[idx[j]];
+      // Velocity of (b_c - a_c) per unit impulse n_d on b_d and -n_d on a_d.
+      const Mat<Dim> R = cross_block(p, c.b, d.b) - cross_block(p, c.b, d.a) -
+                         cross_block(p, c.a, d.b) + cross_block(p, c.a, d.a);
+      W(i, j) = c.normal.dot(R * d.normal);
+    }
+  }
+  const VecK base = u - W * p0;  // w = base + W p
+  // Every active set, the one with the smallest violation of p >= 0, w >= 0 (relative to each
+  // contact's scale |base_i| + W_ii |p_i|) is taken; an exact solution has none.
+  VecK best;
+  double best_violation = std::numeric_limits<double>::infinity();
+  for (int mask = 0; mask < (1 << k); ++mask) {
+    VecK q = VecK::Zero(k);
+    int na = 0;
+    std::array<int, kMaxBlock> act{};
+    for (int i = 0; i < k; ++i)
+      if (mask & (1 << i)) act[na++] = i;
+    if (na > 0) {
+      MatK Wa(na, na);
+      VecK ra(na);
+      for (int i = 0; i < na; ++i) {
+        ra[i] = -base[act[i]];
+        for (int j = 0; j < na; ++j) Wa(i, j) = W(act[i], act[j]);
+      }
+      const VecK qa = Wa.completeOrthogonalDecomposition().solve(ra);
+      if (!qa.allFinite()) continue;
+      for (int i = 0; i < na; ++i) q[act[i]] = qa[i];
+    }
+    const VecK w = base + W * q;
+    double violation = 0;
+    for (int i = 0; i < k; ++i) {
+      const double scale =
+          std::abs(base[i]) + W(i, i) * (std::abs(q[i]) + std::abs(p0[i])) + 1e-300;
+      const double wi = (mask & (1 << i)) ? std::abs(w[i]) : std::max(-w[i], 0.0);
+      violation = std::max(violation, wi / scale);
+      if (W(i, i) > 0) violation = std::max(violation, std::max(-q[i], 0.0) * W(i, i) / scale);
+    }
+    if (violation < best_violation) {
+      best_violation = violation;
+      best = q;
+    }
+    if (violation <= 1e-14) break;
+  }
+  if (!(best_violation <= 1e-10)) return false;
+  for (int i = 0; i < k; ++i) {
+    Contact<Dim>& c = p.contacts[idx[i]];
+    const Vec<Dim> P = std::max(best[i], 0.0) * c.normal;
+    const Vec<Dim> dP = P - c.impulse;
+    if (dP == Vec<Dim>::Zero()) continue;
+    respond(p, v, c.b, dP);
+    if (c.a >= 0) respond(p, v, c.a, Vec<Dim>(-dP));
+    c.impulse = P;
+  }
+  return true;
+}
+
 template <int Dim>
 void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, StageTimers* timers,
-           double omega) {
+           double omega, bool node_blocks) {
   const auto nr = static_cast<std::int64_t>(runs.start.size()) - 1;
   const ThreadedRegion threaded(timers, p.contacts.size() > kThreadedContacts);
 #pragma omp parallel for schedule(dynamic, 64) if (p.contacts.size() > kThreadedContacts)
   for (std::int64_t r = 0; r < nr; ++r)
-    for (std::int32_t k = runs.start[r]; k < runs.start[r + 1]; ++k) {
+    for (std::int32_t k = runs.start[r], block_end = k; k < runs.start[r + 1]; ++k) {
+      if (node_blocks && k >= block_end) {  // the next node's contacts [k, block_end)
+        const std::int64_t node = p.slots[p.contacts[runs.order[k]].b].node;
+        block_end = k + 1;
+        while (block_end < runs.start[r + 1] &&
+               p.slots[p.contacts[runs.order[block_end]].b].node == node)
+          ++block_end;
+        if (solve_node_block(p, v, runs.order.data() + k, block_end - k)) {
+          k = block_end - 1;
+          continue;
+        }
+      }
       Contact<Dim>& c = p.contacts[runs.order[k]];
       Vec<Dim> u;
       Mat<Dim> W;
@@ -188,10 +297,10 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& 
     return r;
   }
   auto v = slot_velocities(p);
-  const NodeRuns runs = node_runs(p);
+  const NodeRuns runs = node_runs(p, settings.node_blocks);
   while (r.sweeps < settings.max_sweeps) {
-    sweep(p, v, runs, settings.timers,
-          r.sweeps >= settings.relax_after ? settings.relaxation : 1.0);
+    sweep(p, v, runs, settings.timers, r.sweeps >= settings.relax_after ? settings.relaxation : 1.0,
+          settings.node_blocks);
     ++r.sweeps;
     r.error = error_now();
     if (r.error <= settings.tolerance) {

@@ -335,6 +335,11 @@ Schema build_schema() {
         KeySpec::integer("relax_after", "", "Gauss-Seidel sweeps before the over-relaxation starts")
             .at_least(0)
             .defaults(num(d.contact.relax_after)),
+        KeySpec::boolean("node_blocks",
+                         "solve the frictionless contacts of each node (2 to 6) together and "
+                         "exactly (nodal block Gauss-Seidel) instead of one by one: for nodes "
+                         "where a light field is pinched between grains (docs/contact.md)")
+            .defaults(boolean_text(d.contact.node_blocks)),
         KeySpec::number("impulse_tolerance", "",
                         "relative change of impulses between Newton iterations")
             .greater_than(0.0)
@@ -778,6 +783,7 @@ class ConfigReader {
     r.read("max_sweeps", k.max_sweeps);
     r.read("relaxation", k.relaxation);
     r.read("relax_after", k.relax_after);
+    r.read("node_blocks", k.node_blocks);
     r.read("impulse_tolerance", k.impulse_tolerance);
     r.read("wall_range", k.wall_range);
     r.read("wall_contact", k.wall_contact);

@@ -7,6 +7,7 @@
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <tuple>
 
@@ -904,7 +905,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   // (v^n + v)/2 splits the grid's kinetic energy change into the work of the contact impulses,
   // P . (v^n + v)/2, of the internal and of the body forces; the transfers account for the rest
   // of the points' kinetic energy change.
+  // Per grain, summed in grain order over the ranks (the same bits on any rank count).
   const double theta = settings_.theta;
+  std::vector<double> ledger(4 * grains_.size(), 0.0);
   for (std::size_t g : owned_) {
     const GrainWork& w = *work_[g];
     double kin_grid = 0, work_c = 0, work_int = 0, work_ext = 0;
@@ -915,19 +918,34 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       work_int += ((1.0 - theta) * (w.f_n[a] - w.f_ext[a]) + theta * w.f_int[a]).dot(vm);
       work_ext += w.f_ext[a].dot(vm);
     }
-    stats.contact_work += work_c;
-    stats.stress_work += dt * work_int;
-    stats.body_work += dt * work_ext;
-    stats.transfer_loss += (w.kin_points_n - w.kin_grid_n) + (kin_grid - w.kin_points);
+    ledger[4 * g] = work_c;
+    ledger[4 * g + 1] = (w.kin_points_n - w.kin_grid_n) + (kin_grid - w.kin_points);
+    ledger[4 * g + 2] = dt * work_int;
+    ledger[4 * g + 3] = dt * work_ext;
+  }
+  if (dist) {
+    ScopedStage tc(&timers_, "newton.check.comm");
+    comm_->sum(ledger);  // one rank owns each grain: the sum is exact
+  }
+  for (std::size_t g = 0; g < grains_.size(); ++g) {
+    stats.contact_work += ledger[4 * g];
+    stats.transfer_loss += ledger[4 * g + 1];
+    stats.stress_work += ledger[4 * g + 2];
+    stats.body_work += ledger[4 * g + 3];
   }
   // Contact summary: active contacts and the force of the grains on each wall (-P/dt).
   stats.contacts = static_cast<std::int64_t>(problem_.contacts.size());
-  stats.wall_force.assign(settings_.contact.walls.size(), {0.0, 0.0, 0.0});
+  // Wall forces per grain and wall, summed in grain order over the ranks (each grain's wall
+  // contacts are on its owner's rank, in the serial order): the same bits on any rank count.
+  const std::size_t nw = settings_.contact.walls.size();
+  std::vector<double> wall_f(grains_.size() * nw * Dim, 0.0);
   previous_.clear();
   for (const auto& c : problem_.contacts) {
     if (c.impulse.dot(c.normal) > 0) ++stats.active_contacts;
-    if (c.a < 0)
-      for (int d = 0; d < Dim; ++d) stats.wall_force[c.wall][d] -= c.impulse[d] / dt;
+    if (c.a < 0) {
+      const std::size_t g = static_cast<std::size_t>(problem_.slots[c.b].grain);
+      for (int d = 0; d < Dim; ++d) wall_f[(g * nw + c.wall) * Dim + d] -= c.impulse[d] / dt;
+    }
     const std::int32_t a = c.a < 0 ? -1 - c.wall : problem_.slots[c.a].grain;
     previous_.push_back({slot_key_[c.b], a, problem_.slots[c.b].grain, c.impulse});
   }
@@ -943,20 +961,12 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.linear_solves = n[2];
     stats.factorizations = n[3];
     stats.iterations = static_cast<int>(-it[0]);
-    std::vector<double> f;
-    for (const auto& wf : stats.wall_force) f.insert(f.end(), wf.begin(), wf.end());
-    const std::size_t k = f.size();
-    for (const double e :
-         {stats.contact_work, stats.transfer_loss, stats.stress_work, stats.body_work})
-      f.push_back(e);
-    comm_->sum(f);
-    stats.contact_work = f[k];
-    stats.transfer_loss = f[k + 1];
-    stats.stress_work = f[k + 2];
-    stats.body_work = f[k + 3];
-    for (std::size_t k = 0; k < stats.wall_force.size(); ++k)
-      for (int d = 0; d < 3; ++d) stats.wall_force[k][d] = f[3 * k + d];
+    if (nw > 0) comm_->sum(wall_f);  // one rank holds each grain's wall contacts: exact
   }
+  stats.wall_force.assign(nw, {0.0, 0.0, 0.0});
+  for (std::size_t g = 0; g < grains_.size(); ++g)
+    for (std::size_t k = 0; k < nw; ++k)
+      for (int d = 0; d < Dim; ++d) stats.wall_force[k][d] += wall_f[(g * nw + k) * Dim + d];
   std::sort(previous_.begin(), previous_.end(),
             [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
               return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
@@ -1499,9 +1509,18 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   std::vector<Vec<Dim>> old(problem_.contacts.size());
   for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
   contact::GsResult r;
+  // Debugging (docs/contact.md): MPMCD_WRITE_STALLED_PROBLEM=<folder> writes each problem whose
+  // Gauss-Seidel does not converge, as given (warm start), for contact::read_problem.
+  static const char* const stalled_dir = std::getenv("MPMCD_WRITE_STALLED_PROBLEM");
+  contact::Problem<Dim> given;
+  if (stalled_dir) given = problem_;
   {
     ScopedStage t(&timers_, "contact.gs");
     r = contact::solve_gauss_seidel(problem_, gs_settings());
+  }
+  if (stalled_dir && !r.converged) {
+    static int written = 0;
+    contact::write_problem(given, fmt::format("{}/stalled_{:04d}.txt", stalled_dir, written++));
   }
   stats.gs_sweeps += r.sweeps;
   stats.gs_error = r.error;

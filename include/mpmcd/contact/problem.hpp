@@ -62,6 +62,10 @@ struct GsSettings {
   /// SOR, Cryer 1971), from sweep relax_after on; frictional contacts keep omega = 1 [-].
   double relaxation = 1.0;
   int relax_after = 0;  ///< sweeps done with omega = 1 before the relaxation starts [-]
+  /// Solve the frictionless contacts of each node (2 to 6) together, exactly (nodal block
+  /// Gauss-Seidel), instead of one by one: near-redundant contacts at a node where a light field
+  /// is pinched between two grains then cost one step, not thousands of sweeps.
+  bool node_blocks = true;
   /// Where the threaded sweeps and error sums add their time (ThreadedRegion); none if null.
   StageTimers* timers = nullptr;
 };

@@ -118,6 +118,7 @@ struct ContactSection {
   int max_sweeps = 1000;          ///< Gauss-Seidel sweep limit [-]
   double relaxation = 1.0;        ///< over-relaxation of frictionless contacts (projected SOR) [-]
   int relax_after = 0;            ///< Gauss-Seidel sweeps before the over-relaxation starts [-]
+  bool node_blocks = true;        ///< solve each node's frictionless contacts together [-]
   double impulse_tolerance = 1e-6;  ///< relative impulse change between Newton iterations [-]
   double wall_range = 1.0;          ///< grain nodes within this many cells of a wall take part [-]
   std::string wall_contact = "nodes";     ///< where walls act: "nodes" or "points" (point faces)

@@ -203,10 +203,11 @@ contact::Problem<2> pinched_node(double friction) {
 }
 }  // namespace
 
-TEST(GaussSeidel, OverRelaxationSolvesPinchedNodesFasterToTheSameVelocities) {
+TEST(GaussSeidel, OverRelaxationAndNodeBlocksSolvePinchedNodesFasterToTheSameVelocities) {
   contact::GsSettings plain;
   plain.tolerance = 1e-10;
   plain.max_sweeps = 100000;
+  plain.node_blocks = false;  // one contact at a time
   contact::GsSettings sor = plain;
   sor.relaxation = 1.8;
   auto p1 = pinched_node(0.0), p2 = pinched_node(0.0);
@@ -229,6 +230,26 @@ TEST(GaussSeidel, OverRelaxationSolvesPinchedNodesFasterToTheSameVelocities) {
       v2 += sign1 * p2.contacts[c].impulse / p2.slots[s].mass;
     }
     EXPECT_LT(std::sqrt(p1.slots[s].mass) * (v1 - v2).norm(), 1e-7) << "slot " << s;
+  }
+  // Nodal blocks: the three contacts of the node solved together, exactly, in one sweep (the error
+  // is measured before and after it), to the same velocities.
+  contact::GsSettings blocks = plain;
+  blocks.node_blocks = true;
+  auto p3 = pinched_node(0.0);
+  const auto r3 = contact::solve_gauss_seidel(p3, blocks);
+  std::printf("  nodal blocks %d sweep(s), error %.2e\n", r3.sweeps, r3.error);
+  ASSERT_TRUE(r3.converged);
+  EXPECT_LE(r3.sweeps, 2);
+  for (std::size_t s = 0; s < p1.slots.size(); ++s) {
+    Vec<2> v1 = p1.slots[s].v_free, v3 = p3.slots[s].v_free;
+    for (std::size_t c = 0; c < p1.contacts.size(); ++c) {
+      const double sign = p1.contacts[c].b == static_cast<int>(s) ? 1.0 : -1.0;
+      if (p1.contacts[c].b != static_cast<int>(s) && p1.contacts[c].a != static_cast<int>(s))
+        continue;
+      v1 += sign * p1.contacts[c].impulse / p1.slots[s].mass;
+      v3 += sign * p3.contacts[c].impulse / p3.slots[s].mass;
+    }
+    EXPECT_LT(std::sqrt(p1.slots[s].mass) * (v1 - v3).norm(), 1e-7) << "slot " << s;
   }
   // Frictional contacts are not relaxed: the same sweeps and impulses as plain Gauss-Seidel.
   auto f1 = pinched_node(0.3), f2 = pinched_node(0.3);
