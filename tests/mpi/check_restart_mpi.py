@@ -71,7 +71,7 @@ print(f"2 ranks, stopped at step 130 and restarted: {compared} files compared")
 part200 = os.path.join(work, "part200")
 run([toml, "-o", part200, "--stop-after", "200", *REBALANCE], 2, expect=4)
 run(["--restart", os.path.join(part200, "compaction_mpi_checkpoint_000000200.h5"), *REBALANCE], 2)
-for f in ("compaction_mpi.csv", "compaction_mpi_checkpoint_000000320.h5"):
+for f in ("compaction_mpi.csv", os.path.basename(checkpoints(full)[-1])):  # the end's
     if not filecmp.cmp(os.path.join(full, f), os.path.join(part200, f), shallow=False):
         fail.append(f"restarted at a re-balancing step: {f} differs")
 

@@ -113,7 +113,7 @@ struct ContactSection {
   bool enabled = true;            ///< solve contacts (grain-grain and grain-wall) [-]
   std::string criterion = "gap";  ///< "gap" (points' domains) or "overlap" (support overlap)
   double friction = 0.0;          ///< default grain-grain Coulomb coefficient [-]
-  double mass_fraction = 1e-3;    ///< contact node: field mass above this fraction of a cell's [-]
+  double mass_fraction = 1e-4;    ///< contact node: field mass above this fraction of a cell's [-]
   double tolerance = 1e-8;        ///< Gauss-Seidel error tolerance [-]
   int max_sweeps = 1000;          ///< Gauss-Seidel sweep limit [-]
   double relaxation = 1.0;        ///< over-relaxation of frictionless contacts (projected SOR) [-]

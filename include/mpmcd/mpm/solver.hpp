@@ -57,7 +57,7 @@ struct ContactSettings {
   bool enabled = false;                         ///< solve contacts between grains and with walls
   GapCriterion criterion = GapCriterion::kGap;  ///< grain-grain gap criterion
   double mass_fraction =
-      1e-3;           ///< a field takes part at a node above this fraction of a cell's mass
+      1e-4;           ///< a field takes part at a node above this fraction of a cell's mass
   int materials = 1;  ///< number of materials (size of the friction matrix)
   std::vector<double> friction = {
       0.0};                      ///< mu_f per material pair, row-major materials x materials
