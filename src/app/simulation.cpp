@@ -1257,6 +1257,16 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
         "(stress work not stored) {:.3g} %; unaccounted {:.3g} % of the work",
         in, l.change, pct(contact_dissipation), pct(transfer_dissipation), pct(l.internal),
         pct(l.rest));
+    // The ledger closes to the solver tolerances (about 1e-8 of the work): a remainder above
+    // kLedgerTolerance of the energy scale is work from outside it (docs/accuracy.md).
+    constexpr double kLedgerTolerance = 1e-3;
+    const double scale = std::max({std::abs(in), std::abs(l.change), 1e-300});
+    if (std::abs(l.rest) > kLedgerTolerance * scale)
+      log().warn(
+          "the energy ledger does not close: {:.6g} J/m ({:.3g} % of the work) is unaccounted; "
+          "prescribed grid velocities ([[boundary]]) do work the ledger does not count, and loose "
+          "Newton or Gauss-Seidel tolerances leave a remainder (docs/accuracy.md)",
+          l.rest, 100 * std::abs(l.rest) / scale);
   }
   log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,
              summary.failed_steps, t, summary.wall_seconds, timers);

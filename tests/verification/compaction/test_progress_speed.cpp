@@ -2,7 +2,8 @@
 // 5 m/s, stop at Phi = 0.8). The progress line follows the criterion that will end the run (the
 // [stop] criterion, or end_time when it comes first) and shows Phi, the top wall stress and Z; a
 // wall, or a material point, faster than a fraction of the grains' wave speed is reported (the
-// issue's case: a top wall at 80 m/s, c = 77.85 m/s), a normal compaction is not.
+// issue's case: a top wall at 80 m/s, c = 77.85 m/s), a normal compaction is not; an energy
+// ledger that does not close (work from outside it) is reported.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -110,8 +111,27 @@ TEST(Progress, FollowsTheStopCriterionAndShowsTheCompactionState) {
   EXPECT_NEAR(std::strtod(last.c_str() + phi + 6, nullptr), 0.8, 0.005) << last;
   EXPECT_NE(last.find("sigma_top = -"), std::string::npos) << last;
   EXPECT_NE(last.find(" Pa  Z = "), std::string::npos) << last;
-  // A normal compaction (wall at 0.064 c) is not reported as too fast.
+  // A normal compaction (wall at 0.064 c) is not reported as too fast, and its ledger closes.
   EXPECT_EQ(r.output.find("wave speed"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("ledger does not close"), std::string::npos) << r.output;
+}
+
+// Issue 17, item 8 (energy part): work the ledger cannot see is reported. The tiny compaction
+// pushed by a moving grid platen ([[boundary]] box) instead of its top wall: the walls do no work
+// while the grains gain energy, so the ledger's remainder is that of the platen.
+TEST(Ledger, WorkOfPrescribedGridVelocitiesIsReportedAsNotClosing) {
+  const fs::path dir = scratch("platen");
+  std::string text = with(tiny_input(), "velocity = [0.0, -5.0]\n", "");
+  text = with(text, "point = [0.0, 3.2e-3]", "point = [0.0, 3.45e-3]");
+  text = with(text, "end_time = 4e-4", "end_time = 1e-4");
+  text = with(text, "[[walls]]\nname = \"bottom\"",
+              "[[boundary]]\nnodes = \"box\"\nbox_min = [-0.25e-3, 3.2e-3]\n"
+              "box_max = [3.25e-3, 3.5e-3]\nfix = [\"x\", \"y\"]\nvelocity = [0.0, -5.0]\n"
+              "moving = true\n\n[[walls]]\nname = \"bottom\"");
+  const Result r =
+      run("run -t 1 " + write_case(dir, text).string() + " -o " + (dir / "out").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("[W] the energy ledger does not close"), std::string::npos) << r.output;
 }
 
 // When end_time comes before the [stop] criterion, the progress follows end_time.
