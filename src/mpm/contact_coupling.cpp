@@ -186,14 +186,12 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   stats.gs_error = r.error;
   gs_converged_ = r.converged;
   double num = 0, den = 0;
-  std::vector<Vec<Dim>> slot_p(problem_.slots.size(), Vec<Dim>::Zero());
   for (std::size_t c = 0; c < old.size(); ++c) {
     const auto& ct = problem_.contacts[c];
     num += (ct.impulse - old[c]).squaredNorm();
     den += ct.impulse.squaredNorm();
-    slot_p[ct.b] += ct.impulse;
-    if (ct.a >= 0) slot_p[ct.a] -= ct.impulse;
   }
+  const std::vector<Vec<Dim>> slot_p = contact::net_impulses(problem_);
   // The new impulses enter the grains' residuals; their velocities take the linearised response
   // (v += Z dP, or the lumped v = v_free + P/m), and a grain whose impulses changed iterates again.
   std::vector<double> dv2(work_.size(), -1.0);

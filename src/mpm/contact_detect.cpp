@@ -364,12 +364,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   }
   detect_items_ = items;
   // Warm start: the grains see the previous step's impulses from the first iteration on.
-  std::vector<Vec<Dim>> slot_p(problem_.slots.size(), Vec<Dim>::Zero());
-  for (const auto& c : problem_.contacts) {
-    slot_p[c.b] += c.impulse;
-    if (c.a >= 0) slot_p[c.a] -= c.impulse;
-  }
-  slot_P_ = slot_p;
+  slot_P_ = contact::net_impulses(problem_);
   spread_slot_impulses();
   gs_converged_ = true;
   // Compliance groups: one per grain with contact slots when its linear solver is direct. Only

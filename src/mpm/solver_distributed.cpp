@@ -375,14 +375,12 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
   stats.gs_error = r.error;
   gs_converged_ = r.converged;
   double num = 0, den = 0;
-  std::vector<Vec<Dim>> slot_p(problem_.slots.size(), Vec<Dim>::Zero());
   for (std::size_t c = 0; c < old.size(); ++c) {
     const auto& ct = problem_.contacts[c];
     num += (ct.impulse - old[c]).squaredNorm();
     den += ct.impulse.squaredNorm();
-    slot_p[ct.b] += ct.impulse;
-    if (ct.a >= 0) slot_p[ct.a] -= ct.impulse;
   }
+  const std::vector<Vec<Dim>> slot_p = contact::net_impulses(problem_);
   // 4. New impulses into the grains: own slots here, ghost slots sent back to their owners.
   std::vector<double> dv2(work_.size(), -1.0);
   const auto apply = [&](std::int32_t g, std::int32_t a, const Vec<Dim>& P) {
