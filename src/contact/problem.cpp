@@ -48,8 +48,6 @@ Vec<Dim> local_solution(const Vec<Dim>& u_free, const Mat<Dim>& W, const Vec<Dim
   }
 }
 
-namespace {
-
 // Net impulse on each slot: sum of the impulses of the contacts where it is B, minus where it is A.
 template <int Dim>
 std::vector<Vec<Dim>> net_impulses(const Problem<Dim>& p) {
@@ -60,6 +58,8 @@ std::vector<Vec<Dim>> net_impulses(const Problem<Dim>& p) {
   }
   return net;
 }
+
+namespace {
 
 // Diagonal response block W_ss of slot s: I/m (lumped) or its block of the group's G.
 template <int Dim>
@@ -505,6 +505,7 @@ Problem<Dim> read_problem(const std::string& path) {
 #define MPMCD_INSTANTIATE(D)                                                                      \
   template Vec<D> local_solution<D>(const Vec<D>&, const Mat<D>&, const Vec<D>&, double, double); \
   template double error<D>(const Problem<D>&);                                                    \
+  template std::vector<Vec<D>> net_impulses<D>(const Problem<D>&);                                \
   template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&);                        \
   template void error_terms<D>(const Problem<D>&, double&, double&, StageTimers*);                \
   template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&, const ErrorReduce&);    \

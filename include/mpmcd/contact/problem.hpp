@@ -92,6 +92,11 @@ Vec<Dim> local_solution(const Vec<Dim>& u_free, double w, const Vec<Dim>& n, dou
   return local_solution<Dim>(u_free, Mat<Dim>(w * Mat<Dim>::Identity()), n, gap_over_dt, mu);
 }
 
+/// Net impulse on each slot, in contact order: sum of the impulses of the contacts where it is B,
+/// minus those where it is A [N s] (2D: N s/m).
+template <int Dim>
+std::vector<Vec<Dim>> net_impulses(const Problem<Dim>& problem);
+
 /// Error measure shared by the solver and the tests: with the slot velocities implied by the
 /// current impulses, sqrt(sum_c |P_c - local_c(P)|^2) / sqrt(sum_c |P_c|^2), where local_c is the
 /// exact local solution of contact c with all other impulses fixed (0 when every impulse is 0 and

@@ -62,6 +62,18 @@ contact::Problem<2> stack(double mu) {
 }
 }  // namespace
 
+TEST(NetImpulses, EachSlotGetsItsContactsAsBMinusItsContactsAsA) {
+  // In the stack, contact k acts on slot k (B) and, for k > 0, against slot k - 1 (A).
+  auto p = stack(0.0);
+  for (std::size_t k = 0; k < p.contacts.size(); ++k)
+    p.contacts[k].impulse = Vec<2>(0.5 * k, 1.0 + k);
+  const auto net = contact::net_impulses(p);
+  ASSERT_EQ(net.size(), p.slots.size());
+  for (std::size_t k = 0; k < 4; ++k)
+    EXPECT_EQ(net[k], p.contacts[k].impulse - p.contacts[k + 1].impulse);
+  EXPECT_EQ(net[4], p.contacts[4].impulse);
+}
+
 TEST(GaussSeidel, StackOnWallConvergesToNoPenetration) {
   for (double mu : {0.0, 0.3}) {
     auto p = stack(mu);

@@ -1,0 +1,262 @@
+// The coupling of the grains by Contact Dynamics, staggered with Newton (method.md §4,
+// docs/contact.md): warm-start impulses, slot velocities and impulses, the grains' compliance at
+// their slots (Delassus operator) and the Gauss-Seidel update of the impulses on one rank.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <tuple>
+#include <vector>
+
+#include "solver_detail.hpp"
+
+namespace mpmcd::mpm {
+
+template <int Dim>
+void ImplicitSolver<Dim>::set_warm_start(std::vector<WarmImpulse<Dim>> impulses) {
+  previous_ = std::move(impulses);
+  sort_unique(previous_);
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::sort_unique(std::vector<WarmImpulse<Dim>>& impulses) {
+  const auto key = [](const WarmImpulse<Dim>& x) { return std::tie(x.node, x.a, x.b); };
+  std::stable_sort(
+      impulses.begin(), impulses.end(),
+      [&](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) { return key(x) < key(y); });
+  // One impulse per contact (the union of several ranks' copies holds each once per rank).
+  impulses.erase(std::unique(impulses.begin(), impulses.end(),
+                             [&](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
+                               return key(x) == key(y);
+                             }),
+                 impulses.end());
+}
+
+template <int Dim>
+std::vector<WarmImpulse<Dim>> ImplicitSolver<Dim>::gather_warm_start() const {
+  if (!distributed()) return previous_;
+  parallel::Buffer mine;
+  for (const auto& w : previous_) {
+    mine.put(w.node);
+    mine.put(w.a);
+    mine.put(w.b);
+    for (int d = 0; d < Dim; ++d) mine.put(w.impulse[d]);
+  }
+  std::vector<WarmImpulse<Dim>> all;
+  for (const auto& bytes : comm_->allgather(mine.bytes())) {
+    parallel::Buffer b;
+    b.bytes() = bytes;
+    while (!b.done()) {
+      WarmImpulse<Dim> w;
+      w.node = b.get<std::int64_t>();
+      w.a = b.get<std::int32_t>();
+      w.b = b.get<std::int32_t>();
+      for (int d = 0; d < Dim; ++d) w.impulse[d] = b.get<double>();
+      all.push_back(w);
+    }
+  }
+  sort_unique(all);
+  return all;
+}
+
+template <int Dim>
+Vec<Dim> ImplicitSolver<Dim>::slot_velocity(std::size_t s) const {
+  const GrainWork& w = *work_[slot_ref_[s].first];
+  Vec<Dim> v = Vec<Dim>::Zero();
+  for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k)
+    v += slot_weight_[k] * w.v[slot_node_[k]];
+  return v;
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::spread_slot_impulses() {
+  // Node slots assign (0 + P = P exactly, so runs without face slots keep their bits), face slots
+  // add their weighted impulses.
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
+    for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k)
+      work_[slot_ref_[s].first]->P[slot_node_[k]].setZero();
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
+    if (!slot_is_face_[s]) work_[slot_ref_[s].first]->P[slot_ref_[s].second] = slot_P_[s];
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
+    if (slot_is_face_[s])
+      for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k)
+        work_[slot_ref_[s].first]->P[slot_node_[k]] += slot_weight_[k] * slot_P_[s];
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
+  // Z = A^-1 E (response of the grain's velocities to unit impulses at its slots; A^-1 -> M^-1
+  // for a lumped group) and its slot rows G = E^T Z, from the factorisation of the current Newton
+  // matrix. Column (j, d) of E is sum_k w_jk e_{a_jk, d} (one node of weight 1 for a node slot).
+  GrainWork& w = *work_[g];
+  if (!w.lumped_group) {
+    if (!reuse_factor(w)) {
+      if (!w.tangent_current) {
+        detail::with_shape(settings_.shape, [&](auto tag) { assemble_tangent<decltype(tag)>(g); });
+      }
+      if (!w.factor_current && !factorize_grain(g, dt_)) return;
+    }
+    // Z and G depend only on the factorisation and the slots (fixed within a step).
+    if (w.z_factor == w.factor_count) return;
+    w.z_factor = w.factor_count;
+  }
+  const auto k = static_cast<Eigen::Index>(w.slots.size());
+  const auto ndof = static_cast<Eigen::Index>(w.m.size() * Dim);
+  Eigen::MatrixXd& G = problem_.groups[problem_.slots[w.slots[0]].group].G;
+  // With an LDL^T factorisation P A P^T = L D L^T, G = E^T A^-1 E = Y^T D^-1 Y with
+  // Y = L^-1 P E: forward substitutions only, and Y stays sparse because E's columns touch a
+  // few nodes (the triangular solve skips zero entries). 4x cheaper than Z = A^-1 E for a CPDI
+  // disk (docs/accuracy.md, cost); the velocity response then takes one back substitution.
+  w.z_forward = !w.lumped_group && settings_.linear_solver == LinearSolverKind::kLdlt;
+  // Column (j, d) of E, without the prescribed components (which do not respond).
+  w.Z.setZero(ndof, Dim * k);
+  for (Eigen::Index j = 0; j < k; ++j) {
+    const std::size_t s = static_cast<std::size_t>(w.slots[j]);
+    for (int d = 0; d < Dim; ++d)
+      for (std::int32_t q = slot_start_[s]; q < slot_start_[s + 1]; ++q) {
+        const std::int32_t a = slot_node_[q];
+        if (w.mask[a] & (1u << d)) continue;
+        w.Z(a * Dim + d, Dim * j + d) = slot_weight_[q] / (w.lumped_group ? w.m[a] : 1.0);
+      }
+  }
+  if (w.z_forward) {
+    w.Z = w.ldlt.permutationP() * w.Z;
+    w.ldlt.matrixL().solveInPlace(w.Z);
+    G.noalias() = w.Z.transpose() * w.ldlt.vectorD().cwiseInverse().asDiagonal() * w.Z;
+    return;
+  }
+  if (!w.lumped_group)
+    for (Eigen::Index c = 0; c < Dim * k; ++c)
+      if (w.Z.col(c).squaredNorm() > 0) w.Z.col(c) = linear_solve(g, w.Z.col(c));
+  G.resize(Dim * k, Dim * k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const std::size_t s = static_cast<std::size_t>(w.slots[i]);
+    G.middleRows(Dim * i, Dim) =
+        slot_weight_[slot_start_[s]] * w.Z.middleRows(slot_node_[slot_start_[s]] * Dim, Dim);
+    for (std::int32_t q = slot_start_[s] + 1; q < slot_start_[s + 1]; ++q)
+      G.middleRows(Dim * i, Dim) += slot_weight_[q] * w.Z.middleRows(slot_node_[q] * Dim, Dim);
+  }
+}
+
+template <int Dim>
+double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
+  // Response of each grain: its compliance group (exact, linearised) or the lumped 1/m_I.
+  const auto ngroups = static_cast<std::int64_t>(problem_.groups.size());
+  ThreadedRegion threaded(&timers_, ngroups > 1);
+#pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1)
+  for (std::int64_t gi = 0; gi < ngroups; ++gi)
+    grain_compliance(static_cast<std::size_t>(slot_ref_[problem_.groups[gi].slots[0]].first));
+  threaded.done();
+  for (const auto& w : work_)
+    if (!w->failure.empty()) return 1.0;
+  // Free velocities: the grains' current iterates without their contact impulses (method.md §4).
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
+    const GrainWork& w = *work_[slot_ref_[s].first];
+    const std::int32_t a = slot_ref_[s].second;
+    auto& slot = problem_.slots[s];
+    if (!slot_is_face_[s]) slot.mass = w.m[a];
+    if (slot.group < 0) {  // a node slot alone at its node (face slots are always grouped)
+      slot.v_free = w.v[a] - slot_P_[s] / w.m[a];
+    } else {
+      const auto& group = problem_.groups[slot.group];
+      slot.v_free = slot_is_face_[s] ? slot_velocity(s) : w.v[a];
+      for (std::size_t j = 0; j < group.slots.size(); ++j)
+        slot.v_free -=
+            group.G.template block<Dim, Dim>(Dim * slot.local, Dim * j) * slot_P_[group.slots[j]];
+    }
+  }
+  std::vector<Vec<Dim>> old(problem_.contacts.size());
+  for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
+  contact::GsResult r;
+  // Debugging (docs/contact.md): MPMCD_WRITE_STALLED_PROBLEM=<folder> writes each problem whose
+  // Gauss-Seidel does not converge, as given (warm start), for contact::read_problem.
+  static const char* const stalled_dir = std::getenv("MPMCD_WRITE_STALLED_PROBLEM");
+  contact::Problem<Dim> given;
+  if (stalled_dir) given = problem_;
+  {
+    ScopedStage t(&timers_, "contact.gs");
+    r = contact::solve_gauss_seidel(problem_, gs_settings());
+  }
+  if (stalled_dir && !r.converged) {
+    static int written = 0;
+    contact::write_problem(given, fmt::format("{}/stalled_{:04d}.txt", stalled_dir, written++));
+  }
+  stats.gs_sweeps += r.sweeps;
+  stats.gs_error = r.error;
+  gs_converged_ = r.converged;
+  double num = 0, den = 0;
+  for (std::size_t c = 0; c < old.size(); ++c) {
+    const auto& ct = problem_.contacts[c];
+    num += (ct.impulse - old[c]).squaredNorm();
+    den += ct.impulse.squaredNorm();
+  }
+  const std::vector<Vec<Dim>> slot_p = contact::net_impulses(problem_);
+  // The new impulses enter the grains' residuals; their velocities take the linearised response
+  // (v += Z dP, or the lumped v = v_free + P/m), and a grain whose impulses changed iterates again.
+  std::vector<double> dv2(work_.size(), -1.0);
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
+    GrainWork& w = *work_[slot_ref_[s].first];
+    const std::int32_t a = slot_ref_[s].second;
+    if (slot_p[s] == slot_P_[s] || problem_.slots[s].group >= 0) continue;
+    slot_P_[s] = slot_p[s];
+    w.P[a] = slot_p[s];
+    const Vec<Dim> v_new = problem_.slots[s].v_free + slot_p[s] / w.m[a];
+    double& acc = dv2[slot_ref_[s].first];
+    acc = std::max(acc, 0.0) + w.m[a] * (v_new - w.v[a]).squaredNorm();
+    w.v[a] = v_new;
+  }
+  for (const auto& group : problem_.groups) {
+    const std::int32_t g = slot_ref_[group.slots[0]].first;
+    GrainWork& w = *work_[g];
+    Eigen::VectorXd dP(Dim * static_cast<Eigen::Index>(group.slots.size()));
+    bool changed = false;
+    for (std::size_t j = 0; j < group.slots.size(); ++j) {
+      const std::int32_t s = group.slots[j];
+      const Vec<Dim> d = slot_p[s] - slot_P_[s];
+      changed = changed || d != Vec<Dim>::Zero();
+      dP.template segment<Dim>(Dim * static_cast<Eigen::Index>(j)) = d;
+      slot_P_[s] = slot_p[s];
+    }
+    if (!changed) continue;
+    // dv = A^-1 E dP = Z dP, or P^T L^-T D^-1 Y dP with the forward-only response.
+    Eigen::VectorXd dv = w.Z * dP;
+    if (w.z_forward) {
+      dv = w.ldlt.vectorD().cwiseInverse().asDiagonal() * dv;
+      w.ldlt.matrixU().solveInPlace(dv);
+      dv = w.ldlt.permutationPinv() * dv;
+    }
+    double acc = 0;
+    for (std::size_t a = 0; a < w.m.size(); ++a) {
+      const Vec<Dim> d = dv.template segment<Dim>(static_cast<Eigen::Index>(a * Dim));
+      w.v[a] += d;
+      acc += w.m[a] * d.squaredNorm();
+    }
+    dv2[g] = acc;
+  }
+  if (!problem_.groups.empty()) spread_slot_impulses();
+  for (std::size_t g = 0; g < work_.size(); ++g)
+    if (dv2[g] >= 0.0) {
+      work_[g]->converged = false;
+      work_[g]->solved_once = true;
+      work_[g]->dv_norm = std::sqrt(dv2[g]);
+    }
+  if (num == 0.0) return gs_converged_ ? 0.0 : 1.0;
+  const double change = std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
+  return gs_converged_ ? change : std::max(change, 1.0);
+}
+
+// The members defined here (the class is instantiated in solver.cpp).
+#define MPMCD_INSTANTIATE(D)                                                         \
+  template void ImplicitSolver<D>::set_warm_start(std::vector<WarmImpulse<D>>);      \
+  template void ImplicitSolver<D>::sort_unique(std::vector<WarmImpulse<D>>&);        \
+  template std::vector<WarmImpulse<D>> ImplicitSolver<D>::gather_warm_start() const; \
+  template Vec<D> ImplicitSolver<D>::slot_velocity(std::size_t) const;               \
+  template void ImplicitSolver<D>::spread_slot_impulses();                           \
+  template void ImplicitSolver<D>::grain_compliance(std::size_t);                    \
+  template double ImplicitSolver<D>::update_contacts(StepStats&);
+MPMCD_INSTANTIATE(2)
+MPMCD_INSTANTIATE(3)
+#undef MPMCD_INSTANTIATE
+
+}  // namespace mpmcd::mpm

@@ -1,0 +1,424 @@
+// Contact detection at x^n (method.md §4, docs/contact.md): the slots (grain-field nodes, and the
+// faces of the points facing a wall) and the grain-grain and grain-wall contacts with their
+// normals, gaps and warm-start impulses, then the compliance groups.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+#include <vector>
+
+#include "solver_detail.hpp"
+
+namespace mpmcd::mpm {
+
+template <int Dim>
+std::int32_t ImplicitSolver<Dim>::slot_of(std::int32_t g, std::int32_t a) {
+  const std::int64_t node = work_[g]->node_global[a];
+  if (slot_stamp_[node] != stamp_) {
+    slot_stamp_[node] = stamp_;
+    slot_head_[node] = -1;
+  }
+  for (std::int32_t s = slot_head_[node]; s >= 0; s = slot_next_[s])
+    if (slot_ref_[s].first == g) return s;
+  const auto s = static_cast<std::int32_t>(problem_.slots.size());
+  const GrainWork& w = *work_[g];
+  problem_.slots.push_back({w.m[a], w.v[a], g, node});
+  slot_ref_.emplace_back(g, a);
+  slot_next_.push_back(slot_head_[node]);
+  slot_head_[node] = s;
+  slot_node_.push_back(a);
+  slot_weight_.push_back(1.0);
+  slot_start_.push_back(static_cast<std::int32_t>(slot_node_.size()));
+  slot_is_face_.push_back(0);
+  slot_key_.push_back(node);
+  return s;
+}
+
+template <int Dim>
+std::int32_t ImplicitSolver<Dim>::face_slot(std::int32_t g, const std::vector<std::int64_t>& pts,
+                                            const Vec<Dim>& n, Vec<Dim>& x_face) {
+  // The point's domain x_p + D s, s in [-1, 1]^Dim, D = F D0; the face toward the wall (normal
+  // n into the domain) is the set of corners minimising s . D^T n. Its velocity is the mean of
+  // the corners' velocities interpolated with the linear hat (the same corner kinematics as
+  // CPDI): weights w_I = mean over the face corners of N_I(x_c).
+  const GrainWork& w = *work_[g];
+  const double h = grid_.cell_size();
+  std::vector<std::int32_t> nodes;
+  std::vector<double> weights;
+  int count = 0;
+  double total = 0;
+  x_face.setZero();
+  for (const std::int64_t p : pts) {
+    const Mat<Dim> D = points_.F[p] * points_.domain[p];
+    const Vec<Dim> dn = D.transpose() * n;
+    const double tol = 1e-9 * D.cwiseAbs().maxCoeff();
+    Vec<Dim> s;
+    for (int d = 0; d < Dim; ++d) s[d] = std::abs(dn[d]) <= tol ? 0.0 : (dn[d] > 0 ? -1.0 : 1.0);
+    int free_axes = 0;
+    for (int d = 0; d < Dim; ++d) free_axes += s[d] == 0.0;
+    const int corners = 1 << free_axes;
+    x_face += (points_.x[p] + D * s) / static_cast<double>(pts.size());
+    for (int c = 0; c < corners; ++c) {
+      Vec<Dim> sc = s;
+      for (int d = 0, bit = 0; d < Dim; ++d)
+        if (s[d] == 0.0) sc[d] = (c >> bit++) & 1 ? 1.0 : -1.0;
+      const Vec<Dim> xi = (points_.x[p] + D * sc - grid_.origin()) / h;
+      IVec<Dim> cell;
+      Vec<Dim> t;
+      for (int d = 0; d < Dim; ++d) {
+        cell[d] = static_cast<std::int64_t>(std::floor(xi[d]));
+        t[d] = xi[d] - static_cast<double>(cell[d]);
+      }
+      for (int b = 0; b < (1 << Dim); ++b) {
+        double wt = 1.0 / corners;
+        IVec<Dim> node = cell - w.box_lo;
+        for (int d = 0; d < Dim; ++d) {
+          const int up = (b >> d) & 1;
+          wt *= up ? t[d] : 1.0 - t[d];
+          node[d] += up;
+        }
+        if (wt == 0.0) continue;
+        if ((node.array() < 0).any() || (node.array() >= w.box_n.array()).any()) continue;
+        std::int64_t idx = 0, mul = 1;
+        for (int d = 0; d < Dim; ++d) {
+          idx += node[d] * mul;
+          mul *= w.box_n[d];
+        }
+        const std::int32_t a = w.box_to_active[idx];
+        if (a < 0) continue;  // no mass there: the face's weight goes to the other nodes
+        int k = 0;
+        while (k < count && nodes[k] != a) ++k;
+        if (k == count) {
+          nodes.push_back(a);
+          weights.push_back(0.0);
+          ++count;
+        }
+        weights[k] += wt;
+        total += wt;
+      }
+    }
+  }
+  if (count == 0 || !(total > 0)) return -1;
+  const auto sidx = static_cast<std::int32_t>(problem_.slots.size());
+  double inv_mass = 0;
+  std::int32_t primary = nodes[0];
+  double wmax = 0;
+  for (int k = 0; k < count; ++k) {
+    weights[k] /= total;
+    slot_node_.push_back(nodes[k]);
+    slot_weight_.push_back(weights[k]);
+    inv_mass += weights[k] * weights[k] / w.m[nodes[k]];
+    if (weights[k] > wmax) {
+      wmax = weights[k];
+      primary = nodes[k];
+    }
+  }
+  slot_start_.push_back(static_cast<std::int32_t>(slot_node_.size()));
+  slot_is_face_.push_back(1);
+  slot_key_.push_back(-1);
+  problem_.slots.push_back({1.0 / inv_mass, Vec<Dim>::Zero(), g, w.node_global[primary]});
+  slot_ref_.emplace_back(g, primary);
+  slot_next_.push_back(-1);  // not linked to its node: slot_of never returns a face slot
+  problem_.slots.back().v_free = slot_velocity(static_cast<std::size_t>(sidx));
+  return sidx;
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::detect_contacts(double dt) {
+  const ContactSettings<Dim>& cs = settings_.contact;
+  const double h = grid_.cell_size();
+  problem_.dt = dt;
+  problem_.slots.clear();
+  problem_.contacts.clear();
+  slot_ref_.clear();
+  slot_next_.clear();
+  slot_start_.assign(1, 0);
+  slot_node_.clear();
+  slot_weight_.clear();
+  slot_is_face_.clear();
+  slot_key_.clear();
+  const auto nn = static_cast<std::size_t>(grid_.node_count());
+  if (node_stamp_.size() != nn) {
+    node_stamp_.assign(nn, 0);
+    slot_stamp_.assign(nn, 0);
+    node_head_.assign(nn, -1);
+    slot_head_.assign(nn, -1);
+  }
+  ++stamp_;
+  const auto warm = [&](std::int64_t node, std::int32_t a, std::int32_t b) -> Vec<Dim> {
+    const WarmImpulse<Dim> key{node, a, b, Vec<Dim>::Zero()};
+    auto it = std::lower_bound(previous_.begin(), previous_.end(), key,
+                               [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
+                                 return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
+                               });
+    if (it != previous_.end() && it->node == node && it->a == a && it->b == b) return it->impulse;
+    return Vec<Dim>::Zero();
+  };
+  // Extent of point p's domain (reference half-edges r_i, the columns of `domain`, mapped by F)
+  // along the unit vector n: sum_i |n . F r_i| [m] (lp |F^T n|_1 for a lattice square).
+  const auto extent = [&](std::int64_t p, const Vec<Dim>& n) {
+    return (points_.domain[p].transpose() * (points_.F[p].transpose() * n)).cwiseAbs().sum();
+  };
+  // 1. Grain fields carrying mass at each node: linked entries per global node.
+  struct Entry {
+    std::int32_t g, a, next;
+  };
+  std::vector<Entry> entries;
+  std::vector<std::int64_t> shared;
+  for (std::size_t g : local_) {
+    const GrainWork& w = *work_[g];
+    for (std::size_t a = 0; a < w.m.size(); ++a) {
+      if (w.m[a] < w.contact_mass) continue;
+      const std::int64_t n = w.node_global[a];
+      if (node_stamp_[n] != stamp_) {
+        node_stamp_[n] = stamp_;
+        node_head_[n] = -1;
+      }
+      const std::int32_t head = node_head_[n];
+      if (head >= 0 && entries[head].next < 0) shared.push_back(n);  // second field here
+      entries.push_back({static_cast<std::int32_t>(g), static_cast<std::int32_t>(a), head});
+      node_head_[n] = static_cast<std::int32_t>(entries.size()) - 1;
+    }
+  }
+  // The rank solving the contacts at node n (docs/parallel.md): the owner of the lowest grain with
+  // a field there (partition) or rank 0 (master); every rank sees all the fields at its nodes.
+  const bool dist = distributed();
+  const int me = dist ? comm_->rank() : 0;
+  const auto node_rank = [&](std::int64_t n) {
+    if (!dist) return 0;
+    if (scheme_ == parallel::Scheme::kMaster) return 0;
+    std::int32_t gmin = std::numeric_limits<std::int32_t>::max();
+    for (std::int32_t e = node_head_[n]; e >= 0; e = entries[e].next)
+      gmin = std::min(gmin, entries[e].g);
+    return owner_[gmin];
+  };
+  // 2. Grain-grain contacts: every pair of fields at a shared node (three grains: three pairs).
+  // Normals and gaps per node in parallel (threads), then the contacts in the serial order.
+  struct Candidate {
+    Entry A, B;
+    Vec<Dim> normal;
+    double gap;
+  };
+  std::vector<std::vector<Candidate>> found(shared.size());
+  const auto nshared = static_cast<std::int64_t>(shared.size());
+  // Work count (Comm::count_work): node fields, pairs and point pairs of the gaps examined here.
+  double items = static_cast<double>(entries.size());
+  ThreadedRegion threaded(&timers_, nshared > 256);
+#pragma omp parallel for schedule(dynamic, 32) if (nshared > 256) reduction(+ : items)
+  for (std::int64_t i = 0; i < nshared; ++i) {
+    const std::int64_t n = shared[i];
+    if (node_rank(n) != me) continue;
+    for (std::int32_t e1 = node_head_[n]; e1 >= 0; e1 = entries[e1].next)
+      for (std::int32_t e2 = entries[e1].next; e2 >= 0; e2 = entries[e2].next) {
+        Entry A = entries[e1], B = entries[e2];
+        if (A.g > B.g) std::swap(A, B);
+        const GrainWork& wa = *work_[A.g];
+        const GrainWork& wb = *work_[B.g];
+        items += 1.0 + (wa.node_pts_start[A.a + 1] - wa.node_pts_start[A.a]) *
+                           (wb.node_pts_start[B.a + 1] - wb.node_pts_start[B.a]);
+        // Normal from A to B (method.md §4). g^X = sum_p m_p grad N_I(x_p) points OUT of grain X
+        // (grad N_I at a point points toward the node), i.e. it is minus the gradient of X's mass
+        // density, so n ∝ grad rho^B - grad rho^A = g^A - g^B.
+        Vec<Dim> normal = wa.grad_m[A.a] - wb.grad_m[B.a];
+        const double len = normal.norm();
+        if (!(len > 1e-12 * (wa.grad_m[A.a].norm() + wb.grad_m[B.a].norm()))) continue;
+        normal /= len;
+        double gap = 0;
+        if (cs.criterion == GapCriterion::kGap) {
+          // Gap near the node: the smallest distance between a point domain of A and one of B
+          // in the node's support, |x_q - x_p| minus both domains' extents along x_q - x_p
+          // (a projection on the node's normal underestimates it where the normal is tilted).
+          gap = std::numeric_limits<double>::infinity();
+          for (std::int32_t k = wa.node_pts_start[A.a]; k < wa.node_pts_start[A.a + 1]; ++k) {
+            const std::int64_t p = grains_[A.g].begin + wa.node_pts[k];
+            for (std::int32_t l = wb.node_pts_start[B.a]; l < wb.node_pts_start[B.a + 1]; ++l) {
+              const std::int64_t q = grains_[B.g].begin + wb.node_pts[l];
+              const Vec<Dim> d = points_.x[q] - points_.x[p];
+              const double len_d = d.norm();
+              if (!(len_d > 0)) {
+                gap = 0;
+                continue;
+              }
+              const Vec<Dim> e = d / len_d;
+              gap = std::min(gap, len_d - extent(p, e) - extent(q, e));
+            }
+          }
+          gap = std::max(0.0, gap);
+        }
+        found[i].push_back({A, B, normal, gap});
+      }
+  }
+  threaded.done();
+  for (std::size_t i = 0; i < shared.size(); ++i)
+    for (const Candidate& f : found[i]) {
+      contact::Contact<Dim> c;
+      c.a = slot_of(f.A.g, f.A.a);
+      c.b = slot_of(f.B.g, f.B.a);
+      c.normal = f.normal;
+      c.gap = f.gap;
+      c.friction = cs.friction[grains_[f.A.g].material * cs.materials + grains_[f.B.g].material];
+      c.impulse = warm(shared[i], f.A.g, f.B.g);
+      problem_.contacts.push_back(c);
+    }
+  // 3. Grain-wall contacts: grain nodes within wall_range cells of a wall; gap from the points.
+  for (std::size_t wi = 0; wi < cs.walls.size(); ++wi) {
+    const Wall<Dim>& wall = cs.walls[wi];
+    for (std::size_t g : local_) {
+      const GrainWork& w = *work_[g];
+      if (cs.wall_points) {
+        // Face contacts (ContactSettings::wall_points, docs/accuracy.md): per cell column
+        // along the wall, the faces of the grain's points nearest the wall in that column (within
+        // half a point's extent of the nearest) make one contact on their mean velocity; gap = the
+        // mean distance of those faces from the wall (Signorini on the face velocity,
+        // u_n + g/dt >= 0, method.md §4). One contact per column keeps the constraints
+        // independent (one per face would give two per column of nodes when the material edge
+        // lies on a grid line, a singular Delassus operator and a stalling Gauss-Seidel).
+        struct Face {
+          std::int64_t column, p;
+          double dist, ext;
+        };
+        std::vector<Face> faces;
+        for (std::int64_t p = grains_[g].begin; p < grains_[g].end; ++p) {
+          const double e = extent(p, wall.normal);
+          const double dface = wall.distance(points_.x[p], time_) - e;
+          if (dface > cs.wall_range * h) continue;
+          // Column index: the cell of the point along the wall's tangent axes.
+          const Vec<Dim> xt = points_.x[p] - points_.x[p].dot(wall.normal) * wall.normal;
+          std::int64_t column = 0;
+          for (int d = 0; d < Dim; ++d)
+            column = column * 1000003 + static_cast<std::int64_t>(std::floor(xt[d] / h));
+          faces.push_back({column, p, dface, e});
+        }
+        items += static_cast<double>(faces.size());
+        std::sort(faces.begin(), faces.end(), [](const Face& x, const Face& y) {
+          return std::tie(x.column, x.dist, x.p) < std::tie(y.column, y.dist, y.p);
+        });
+        for (std::size_t f0 = 0; f0 < faces.size();) {
+          std::size_t f1 = f0;
+          std::vector<std::int64_t> pts;
+          while (f1 < faces.size() && faces[f1].column == faces[f0].column) {
+            if (faces[f1].dist <= faces[f0].dist + 0.5 * faces[f0].ext) pts.push_back(faces[f1].p);
+            ++f1;
+          }
+          f0 = f1;
+          Vec<Dim> x_face;
+          const std::int32_t sb = face_slot(static_cast<std::int32_t>(g), pts, wall.normal, x_face);
+          if (sb < 0) continue;
+          // Warm-start key of a face contact: -1 - the grid cell of the mean face centre projected
+          // on the wall's plane through the origin (the column: stable while the faces move
+          // toward the wall and cross grid lines, when a lost warm start would hurt most).
+          const Vec<Dim> xt = x_face - x_face.dot(wall.normal) * wall.normal;
+          IVec<Dim> cell;
+          for (int d = 0; d < Dim; ++d)
+            cell[d] = std::clamp<std::int64_t>(
+                static_cast<std::int64_t>(std::floor((xt[d] - grid_.origin()[d]) / h)), 0,
+                grid_.cells()[d] - 1);
+          slot_key_[sb] = -1 - grid_.node_index(cell);
+          contact::Contact<Dim> c;
+          c.a = -1;
+          c.wall = static_cast<std::int32_t>(wi);
+          c.b = sb;
+          c.normal = wall.normal;
+          c.wall_velocity = wall.velocity;
+          c.gap = std::max(0.0, wall.distance(x_face, time_));
+          c.friction = wall.friction;
+          c.impulse =
+              warm(slot_key_[sb], -1 - static_cast<std::int32_t>(wi), static_cast<std::int32_t>(g));
+          problem_.contacts.push_back(c);
+        }
+        continue;
+      }
+      for (std::size_t a = 0; a < w.m.size(); ++a) {
+        if (w.m[a] < w.contact_mass) continue;
+        if (dist && node_rank(w.node_global[a]) != me) continue;
+        const Vec<Dim> xn = grid_.node_position(grid_.node_coords(w.node_global[a]));
+        if (wall.distance(xn, time_) > cs.wall_range * h) continue;
+        items += 1.0 + (w.node_pts_start[a + 1] - w.node_pts_start[a]);
+        double gap = std::numeric_limits<double>::infinity(), ext = 0;
+        for (std::int32_t k = w.node_pts_start[a]; k < w.node_pts_start[a + 1]; ++k) {
+          const std::int64_t p = grains_[g].begin + w.node_pts[k];
+          const double e = extent(p, wall.normal);
+          ext = std::max(ext, e);
+          gap = std::min(gap, wall.distance(points_.x[p], time_) - e);
+        }
+        if (!std::isfinite(gap)) continue;
+        // A node inside the grain may approach the wall until one whole point domain (twice the
+        // largest half-extent e of its points along n) still fits between it and the wall:
+        // gap >= d_node - 2 e. Without the 2 e the points between it and the wall are pushed
+        // through by up to e (measured: up to 0.25 h, and the Hertz load sagging); with the
+        // points' gap alone the layer down to the first node row would move with the wall.
+        gap = std::max(gap, wall.distance(xn, time_) - 2 * ext);
+        contact::Contact<Dim> c;
+        c.a = -1;
+        c.wall = static_cast<std::int32_t>(wi);
+        c.b = slot_of(static_cast<std::int32_t>(g), static_cast<std::int32_t>(a));
+        c.normal = wall.normal;
+        c.wall_velocity = wall.velocity;
+        c.gap = std::max(0.0, gap);
+        c.friction = wall.friction;
+        c.impulse = warm(w.node_global[a], -1 - static_cast<std::int32_t>(wi),
+                         static_cast<std::int32_t>(g));
+        problem_.contacts.push_back(c);
+      }
+    }
+  }
+  detect_items_ = items;
+  // Warm start: the grains see the previous step's impulses from the first iteration on.
+  slot_P_ = contact::net_impulses(problem_);
+  spread_slot_impulses();
+  gs_converged_ = true;
+  // Compliance groups: one per grain with contact slots when its linear solver is direct. Only
+  // slots of contacts that may act in this step join (gap below a quarter cell, or an impulse
+  // from the previous step): closing a quarter cell within one step takes a relative speed of
+  // h / (4 dt), far above any in a quasi-static run. The other slots (most candidates of a dense
+  // packing: their fields overlap a cell before the materials meet) keep the lumped 1/m_I, which
+  // still holds them if a fast impact closes their gap.
+  for (auto& w : work_) w->slots.clear();
+  problem_.groups.clear();
+  if (dist) return;  // lumped operator only (set_distribution)
+  const bool compliance = cs.grain_compliance && settings_.linear_solver != LinearSolverKind::kCg;
+  // A grain with face slots needs a group in any case: its face slots share nodes with each other
+  // and with its node slots (lumped groups, G = E^T M^-1 E, when the compliance is not used).
+  std::vector<char> has_face(work_.size(), 0);
+  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
+    if (slot_is_face_[s]) has_face[slot_ref_[s].first] = 1;
+  for (std::size_t g = 0; g < work_.size(); ++g) work_[g]->lumped_group = !compliance;
+  if (compliance || std::find(has_face.begin(), has_face.end(), 1) != has_face.end()) {
+    std::vector<char> near(slot_ref_.size(), 0);
+    for (const auto& c : problem_.contacts)
+      if (!compliance || c.gap <= 0.25 * h || c.impulse.squaredNorm() > 0) {
+        near[c.b] = 1;
+        if (c.a >= 0) near[c.a] = 1;
+      }
+    for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
+      if (slot_is_face_[s]) near[s] = 1;
+      if (!has_face[slot_ref_[s].first]) near[s] = compliance && near[s];
+    }
+    for (std::size_t s = 0; s < slot_ref_.size(); ++s)
+      if (near[s]) work_[slot_ref_[s].first]->slots.push_back(static_cast<std::int32_t>(s));
+    for (std::size_t g = 0; g < work_.size(); ++g) {
+      const auto& sl = work_[g]->slots;
+      if (sl.empty()) continue;
+      const auto gi = static_cast<std::int32_t>(problem_.groups.size());
+      contact::Group group;
+      group.slots = sl;
+      for (std::size_t j = 0; j < sl.size(); ++j) {
+        problem_.slots[sl[j]].group = gi;
+        problem_.slots[sl[j]].local = static_cast<std::int32_t>(j);
+      }
+      problem_.groups.push_back(std::move(group));
+    }
+  }
+}
+
+// The members defined here (the class is instantiated in solver.cpp).
+#define MPMCD_INSTANTIATE(D)                                                    \
+  template std::int32_t ImplicitSolver<D>::slot_of(std::int32_t, std::int32_t); \
+  template std::int32_t ImplicitSolver<D>::face_slot(                           \
+      std::int32_t, const std::vector<std::int64_t>&, const Vec<D>&, Vec<D>&);  \
+  template void ImplicitSolver<D>::detect_contacts(double);
+MPMCD_INSTANTIATE(2)
+MPMCD_INSTANTIATE(3)
+#undef MPMCD_INSTANTIATE
+
+}  // namespace mpmcd::mpm

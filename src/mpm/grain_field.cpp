@@ -1,0 +1,399 @@
+// The grain field's transfers (multi-field MPM, method.md §1-2): P2G with the active nodes and the
+// sparse pattern of the Newton matrix (setup_grain), G2P (g2p_point, commit_grain) and its check
+// of the next positions, and the field's diagnostics.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "solver_detail.hpp"
+
+namespace mpmcd::mpm {
+
+namespace {
+template <class T>
+void reset(std::vector<T>& v, std::size_t n, const T& value) {
+  v.assign(n, value);
+}
+}  // namespace
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
+  using Shape = typename grid::ShapeOf<Dim, S1>::type;
+  constexpr int K = Shape::K;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  const std::int64_t np = gr.size();
+  const double h = grid_.cell_size();
+  w.K = K;
+  w.converged = false;
+  w.solved_once = false;
+  w.iterations = 0;
+  w.solves = 0;
+  w.factorizations = 0;
+  w.failure.clear();
+  w.retryable = true;
+  w.fail_point = -1;
+  w.history.clear();
+  w.factor_in_step = false;
+  w.z_factor = -1;
+  w.pt_first.resize(np);
+  w.pt_N.resize(np * K);
+  w.pt_dN.resize(np * K);
+  w.pt_node.resize(np * K);
+  // Pass 1: shape functions at x^n and the node box of the grain.
+  IVec<Dim> lo = IVec<Dim>::Constant(std::numeric_limits<std::int64_t>::max());
+  IVec<Dim> hi = IVec<Dim>::Constant(std::numeric_limits<std::int64_t>::min());
+  Shape ps;
+  for (std::int64_t i = 0; i < np; ++i) {
+    const std::int64_t p = gr.begin + i;
+    if (!ps.eval(points_.x[p], grid_.origin(), h, gr.half_width,
+                 points_.F[p] * points_.domain[p])) {
+      w.failure =
+          "material point domain spans more than two cells along an axis (stretched over about "
+          "twice its size: seed more points per cell)";
+      w.fail_point = p;
+      return;
+    }
+    w.pt_first[i] = ps.first;
+    for (int a = 0; a < K; ++a) {
+      w.pt_N[i * K + a] = ps.N[a];
+      w.pt_dN[i * K + a] = ps.dN[a];
+    }
+    lo = lo.cwiseMin(ps.first);
+    hi = hi.cwiseMax(ps.first + IVec<Dim>::Constant(S1::kNodes - 1));
+    if ((ps.first.array() < 0).any() ||
+        ((ps.first.array() + S1::kNodes - 1) >= grid_.nodes_per_axis().array()).any() ||
+        !points_.x[p].allFinite()) {
+      w.failure =
+          "material point left the grid (or came within the shape-function support of its edge)";
+      w.retryable = false;
+      w.fail_point = p;
+      return;
+    }
+  }
+  if (np == 0) return;
+  w.box_lo = lo;
+  w.box_n = hi - lo + IVec<Dim>::Ones();
+  const std::size_t nb = static_cast<std::size_t>(w.box_n.prod());
+  IVec<Dim> stride;
+  stride[0] = 1;
+  for (int d = 1; d < Dim; ++d) stride[d] = stride[d - 1] * w.box_n[d - 1];
+  reset(w.box_m, nb, 0.0);
+  reset(w.box_mv, nb, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.box_f, nb, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.box_fext, nb, Vec<Dim>(Vec<Dim>::Zero()));
+  const bool contact = settings_.contact.enabled;
+  const bool affine = settings_.affine;
+  if (contact) reset(w.box_gm, nb, Vec<Dim>(Vec<Dim>::Zero()));
+  // Pass 2: P2G (method.md §2): m_I = sum N m_p, m_I v_I = sum N m_p v_p,
+  // f_I^n = -sum V_p sigma_p grad N_I (seed eq. 5) + sum N m_p g.
+  for (std::int64_t i = 0; i < np; ++i) {
+    const std::int64_t p = gr.begin + i;
+    const IVec<Dim> base = w.pt_first[i] - lo;
+    const double mp = points_.mass[p];
+    const Vec<Dim> mv = mp * points_.v[p];
+    const Mat<Dim> mL = mp * points_.L[p];
+    const Vec<Dim> mg = mp * settings_.gravity;
+    const Mat<Dim> Vs = points_.volume[p] * points_.sigma[p];
+    for (int a = 0; a < K; ++a) {
+      IVec<Dim> c = base;
+      for (int d = 0; d < Dim; ++d) c[d] += Shape::offset(a, d);
+      const std::int64_t b = c.dot(stride);
+      const double N = w.pt_N[i * K + a];
+      w.box_m[b] += N * mp;
+      w.box_mv[b] += N * mv;
+      // Affine P2G: + N m_p L_p (x_I - x_p) (Settings::affine).
+      if (affine) w.box_mv[b] += N * (mL * (grid_.node_position(c + lo) - points_.x[p]));
+      w.box_f[b] -= Vs * w.pt_dN[i * K + a];
+      w.box_fext[b] += N * mg;
+      if (contact) w.box_gm[b] += mp * w.pt_dN[i * K + a];  // grad m_I = sum m_p grad N_I (§4)
+    }
+  }
+  // Keep the previous step's active set to reuse the sparse pattern when it has not changed.
+  w.prev_box_to_active.swap(w.box_to_active);
+  const bool same_box = w.pattern_valid && w.prev_box_lo == lo && w.prev_box_n == w.box_n;
+  w.prev_box_lo = lo;
+  w.prev_box_n = w.box_n;
+  reset(w.box_to_active, nb, std::int32_t{-1});
+  w.node_global.clear();
+  w.node_box.clear();
+  w.m.clear();
+  w.v_p2g.clear();
+  w.f_n.clear();
+  w.f_ext.clear();
+  w.grad_m.clear();
+  // Active nodes carry more than round-off mass (uGIMP tails at a material edge lying on a grid
+  // line give weights ~1e-17 that would only make the Newton matrix ill-conditioned).
+  double mp_max = 0;
+  for (std::int64_t i = 0; i < np; ++i) mp_max = std::max(mp_max, points_.mass[gr.begin + i]);
+  // CPDI (docs/accuracy.md): a domain corner just past a grid line gives its far nodes weights
+  // down to round-off; such a node's velocity is the ratio of two vanishing forces and, when a
+  // wall face rests on it, it spoils the contact problem (measured: the walled block's exact state
+  // lost at s = 0.80 with 1e-13; exact to s = 0.5 with 1e-6). The mass left out (below 1e-6 of a
+  // point's per node) is the price: momentum drift ~1e-6 instead of round-off.
+  const double m_min = (settings_.shape == grid::ShapeKind::kCpdi ? 1e-6 : 1e-13) * mp_max;
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (!(w.box_m[b] > m_min)) continue;
+    w.box_to_active[b] = static_cast<std::int32_t>(w.m.size());
+    IVec<Dim> c;
+    std::int64_t r = static_cast<std::int64_t>(b);
+    for (int d = 0; d < Dim; ++d) {
+      c[d] = r % w.box_n[d];
+      r /= w.box_n[d];
+    }
+    w.node_box.push_back(c);
+    w.node_global.push_back(grid_.node_index(c + lo));
+    w.m.push_back(w.box_m[b]);
+    w.v_p2g.push_back(w.box_mv[b] / w.box_m[b]);
+    w.f_n.push_back(w.box_f[b] + w.box_fext[b]);
+    w.f_ext.push_back(w.box_fext[b]);
+    if (contact) w.grad_m.push_back(w.box_gm[b]);
+  }
+  const std::size_t na = w.m.size();
+  for (std::int64_t i = 0; i < np; ++i) {
+    const IVec<Dim> base = w.pt_first[i] - lo;
+    for (int a = 0; a < K; ++a) {
+      IVec<Dim> c = base;
+      for (int d = 0; d < Dim; ++d) c[d] += Shape::offset(a, d);
+      // A window node with zero weight and gradient (CPDI domains inside fewer cells than the
+      // window, uGIMP tails) takes no part: -1 skips it in every loop over the support.
+      const bool zero = w.pt_N[i * K + a] == 0.0 && w.pt_dN[i * K + a].isZero(0.0);
+      w.pt_node[i * K + a] = zero ? -1 : w.box_to_active[c.dot(stride)];
+    }
+    // A support node left out for its (near) zero mass may still carry a full gradient: a point
+    // exactly on a grid line sees the far node of its cell with N = 0 and grad N = 1/h. Dropping
+    // that term breaks sum grad N = 0, so a uniform velocity strains the point (a translated
+    // block: J - 1 = 2e-3 after one such step, test Dynamics.TranslatedBlock...). The remaining
+    // gradients are corrected to grad N_a - (N_a / sum N) sum grad N over the kept nodes, which
+    // restores the partition of unity of the gradients (uniform fields exact).
+    Vec<Dim> g_sum = Vec<Dim>::Zero();
+    double n_sum = 0;
+    bool dropped = false;
+    for (int a = 0; a < K; ++a) {
+      if (w.pt_node[i * K + a] < 0) {
+        dropped = dropped || !w.pt_dN[i * K + a].isZero(0.0);
+        continue;
+      }
+      g_sum += w.pt_dN[i * K + a];
+      n_sum += w.pt_N[i * K + a];
+    }
+    if (dropped && n_sum > 0)
+      for (int a = 0; a < K; ++a)
+        if (w.pt_node[i * K + a] >= 0) w.pt_dN[i * K + a] -= (w.pt_N[i * K + a] / n_sum) * g_sum;
+  }
+  // Boundary conditions: prescribed components of v^n (for the increment) and v^{n+1}.
+  w.mask.assign(na, 0);
+  w.v_n = w.v_p2g;
+  for (std::size_t a = 0; a < na; ++a) {
+    const std::int64_t n = w.node_global[a];
+    const std::uint8_t mk = bc_mask_[n];
+    if (!mk) continue;
+    w.mask[a] = mk;
+    const Vec<Dim> xn = grid_.node_position(w.node_box[a] + lo);
+    for (int d = 0; d < Dim; ++d)
+      if (mk & (1u << d)) w.v_n[a][d] = bcs_[bc_set_[d][n]].value(xn)[d];
+  }
+  w.v = w.v_n;  // initial guess: zero acceleration
+  // Energy ledger: what the P2G (and the prescribed values) keep of the points' kinetic energy.
+  w.kin_points_n = w.kin_grid_n = 0;
+  for (std::int64_t i = 0; i < np; ++i)
+    w.kin_points_n += 0.5 * points_.mass[gr.begin + i] * points_.v[gr.begin + i].squaredNorm();
+  for (std::size_t a = 0; a < na; ++a) w.kin_grid_n += 0.5 * w.m[a] * w.v_n[a].squaredNorm();
+  reset(w.f_int, na, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.f_abs, na, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.P, na, Vec<Dim>(Vec<Dim>::Zero()));
+  if (contact) {
+    // Node -> points lists (for the gaps) and the contact mass threshold of this grain.
+    double m_sum = 0, v_sum = 0;
+    for (std::int64_t i = 0; i < np; ++i) {
+      m_sum += points_.mass[gr.begin + i];
+      v_sum += points_.volume0[gr.begin + i];
+    }
+    w.contact_mass = settings_.contact.mass_fraction * m_sum / v_sum * std::pow(h, Dim);
+    w.node_pts_start.assign(na + 1, 0);
+    for (std::int64_t i = 0; i < np; ++i)
+      for (int a = 0; a < K; ++a)
+        if (w.pt_node[i * K + a] >= 0 && w.pt_N[i * K + a] > 0)
+          ++w.node_pts_start[w.pt_node[i * K + a] + 1];
+    for (std::size_t a = 0; a < na; ++a) w.node_pts_start[a + 1] += w.node_pts_start[a];
+    w.node_pts.resize(w.node_pts_start[na]);
+    std::vector<std::int32_t> fill(w.node_pts_start.begin(), w.node_pts_start.end() - 1);
+    for (std::int64_t i = 0; i < np; ++i)
+      for (int a = 0; a < K; ++a)
+        if (w.pt_node[i * K + a] >= 0 && w.pt_N[i * K + a] > 0)
+          w.node_pts[fill[w.pt_node[i * K + a]]++] = static_cast<std::int32_t>(i);
+  }
+  reset(w.R, na, Vec<Dim>(Vec<Dim>::Zero()));
+  reset(w.du, na, Vec<Dim>(Vec<Dim>::Zero()));
+  (void)dt;
+  // The pattern (stencil, sparse structure, symbolic factorisation) depends only on the active
+  // node set: reuse it when unchanged (the usual case at small dt).
+  if (same_box && w.box_to_active == w.prev_box_to_active) return;
+  w.pattern_valid = true;
+  // Stencil of the tangent: node b couples to node a if |c_b - c_a| <= radius per axis.
+  w.radius = S1::kNodes - 1;
+  const int width = 2 * w.radius + 1;
+  w.S = 1;
+  for (int d = 0; d < Dim; ++d) w.S *= width;
+  w.pair_slot.resize(K * K);
+  for (int a = 0; a < K; ++a)
+    for (int b = 0; b < K; ++b) {
+      int slot = 0, mul = 1;
+      for (int d = 0; d < Dim; ++d) {
+        slot += (Shape::offset(b, d) - Shape::offset(a, d) + w.radius) * mul;
+        mul *= width;
+      }
+      w.pair_slot[a * K + b] = slot;
+    }
+  w.stencil_nb.assign(na * w.S, -1);
+  for (std::size_t a = 0; a < na; ++a)
+    for (int s = 0; s < w.S; ++s) {
+      IVec<Dim> c = w.node_box[a];
+      int r = s;
+      bool inside = true;
+      for (int d = 0; d < Dim; ++d) {
+        c[d] += r % width - w.radius;
+        r /= width;
+        if (c[d] < 0 || c[d] >= w.box_n[d]) inside = false;
+      }
+      if (inside) w.stencil_nb[a * w.S + s] = w.box_to_active[c.dot(stride)];
+    }
+  w.K_blk.resize(na * w.S);
+  // Sparse pattern of the Newton matrix and the map from stencil blocks to stored values.
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(na * w.S * Dim * Dim);
+  for (std::size_t a = 0; a < na; ++a)
+    for (int s = 0; s < w.S; ++s) {
+      const std::int32_t b = w.stencil_nb[a * w.S + s];
+      if (b < 0) continue;
+      for (int i = 0; i < Dim; ++i)
+        for (int j = 0; j < Dim; ++j) trip.emplace_back(a * Dim + i, b * Dim + j, 0.0);
+    }
+  const auto ndof = static_cast<Eigen::Index>(na * Dim);
+  w.A.resize(ndof, ndof);
+  w.A.setFromTriplets(trip.begin(), trip.end());
+  w.A.makeCompressed();
+  w.value_index.assign(na * w.S * Dim * Dim, -1);
+  const int* outer = w.A.outerIndexPtr();
+  const int* inner = w.A.innerIndexPtr();
+  for (std::size_t a = 0; a < na; ++a)
+    for (int s = 0; s < w.S; ++s) {
+      const std::int32_t b = w.stencil_nb[a * w.S + s];
+      if (b < 0) continue;
+      for (int i = 0; i < Dim; ++i)
+        for (int j = 0; j < Dim; ++j) {
+          const int col = b * Dim + j, row = static_cast<int>(a) * Dim + i;
+          const int* pos = std::lower_bound(inner + outer[col], inner + outer[col + 1], row);
+          w.value_index[((a * w.S + s) * Dim + i) * Dim + j] = pos - inner;
+        }
+    }
+  if (settings_.linear_solver == LinearSolverKind::kLdlt) w.ldlt.analyzePattern(w.A);
+  if (settings_.linear_solver == LinearSolverKind::kLu) w.lu.analyzePattern(w.A);
+}
+
+template <int Dim>
+template <class S1>
+typename ImplicitSolver<Dim>::G2P ImplicitSolver<Dim>::g2p_point(const GrainWork& w, std::int64_t p,
+                                                                 std::int64_t i) const {
+  constexpr int K = grid::ShapeOf<Dim, S1>::type::K;
+  const double alpha = settings_.flip;
+  Vec<Dim> dx = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero(), vpic = Vec<Dim>::Zero();
+  Mat<Dim> grad_v = Mat<Dim>::Zero();
+  for (int a = 0; a < K; ++a) {
+    const std::int32_t n = w.pt_node[i * K + a];
+    if (n < 0) continue;
+    const double N = w.pt_N[i * K + a];
+    dx += N * w.du[n];
+    dv += N * (w.v[n] - w.v_p2g[n]);
+    vpic += N * w.v[n];
+    if (settings_.affine) grad_v += w.v[n] * w.pt_dN[i * K + a].transpose();
+  }
+  // v_p = flip (v_p + sum N dv) + (1 - flip) sum N v (method.md §2).
+  return {dx, alpha * (points_.v[p] + dv) + (1.0 - alpha) * vpic, grad_v};
+}
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::commit_grain(std::size_t g) {
+  const points::Grain& gr = grains_[g];
+  const GrainWork& w = *work_[g];
+  for (std::int64_t i = 0; i < gr.size(); ++i) {
+    const std::int64_t p = gr.begin + i;
+    const G2P u = g2p_point<S1>(w, p, i);
+    // Velocity gradient at x^{n+1} for the next affine P2G: grad_{x^n} v dF^-1 (Settings::affine).
+    if (settings_.affine) points_.L[p] = u.grad_v * dF_inv_T_[p].transpose();
+    // G2P: x_p += sum N du (method.md §2).
+    points_.x[p] += u.dx;
+    points_.v[p] = u.v;
+    points_.F[p] = F_trial_[p];
+    points_.sigma[p] = sigma_trial_[p];
+    if constexpr (Dim == 2) points_.sigma_zz[p] = sigma_zz_trial_[p];
+    points_.volume[p] = J_trial_[p] * points_.volume0[p];
+  }
+}
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::check_next_positions(std::size_t g) {
+  using Shape = typename grid::ShapeOf<Dim, S1>::type;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  const double h = grid_.cell_size();
+  Shape ps;
+  w.kin_points = 0;
+  for (std::int64_t i = 0; i < gr.size(); ++i) {
+    const std::int64_t p = gr.begin + i;
+    const G2P u = g2p_point<S1>(w, p, i);  // as commit_grain: the same position and velocity
+    w.kin_points += 0.5 * points_.mass[p] * u.v.squaredNorm();
+    const Vec<Dim> x = points_.x[p] + u.dx;
+    // A domain stretched too far is left to the next step's set-up (a retryable failure there);
+    // its position must still lie on the grid.
+    const bool off =
+        !x.allFinite() ||
+        (ps.eval(x, grid_.origin(), h, gr.half_width, F_trial_[p] * points_.domain[p])
+             ? ((ps.first.array() < 0).any() ||
+                ((ps.first.array() + S1::kNodes - 1) >= grid_.nodes_per_axis().array()).any())
+             : !grid_.inside(x, 0.0));
+    if (off) {
+      w.failure =
+          "material point left the grid (or came within the shape-function support of its edge)";
+      w.retryable = false;
+      w.fail_point = p;
+      return;
+    }
+  }
+}
+
+template <int Dim>
+double ImplicitSolver<Dim>::field_mass(std::size_t g) const {
+  double m = 0;
+  for (double x : work_.at(g)->m) m += x;
+  return m;
+}
+
+template <int Dim>
+Vec<Dim> ImplicitSolver<Dim>::field_momentum(std::size_t g) const {
+  Vec<Dim> p = Vec<Dim>::Zero();
+  const GrainWork& w = *work_.at(g);
+  for (std::size_t a = 0; a < w.m.size(); ++a) p += w.m[a] * w.v[a];
+  return p;
+}
+
+// The members defined here, for each dimension and shape family (the class is instantiated in
+// solver.cpp).
+#define MPMCD_INSTANTIATE_SHAPE(D, S1)                                   \
+  template void ImplicitSolver<D>::setup_grain<S1>(std::size_t, double); \
+  template void ImplicitSolver<D>::commit_grain<S1>(std::size_t);        \
+  template void ImplicitSolver<D>::check_next_positions<S1>(std::size_t);
+#define MPMCD_INSTANTIATE(D)                                        \
+  MPMCD_FOR_EACH_SHAPE(MPMCD_INSTANTIATE_SHAPE, D)                  \
+  template double ImplicitSolver<D>::field_mass(std::size_t) const; \
+  template Vec<D> ImplicitSolver<D>::field_momentum(std::size_t) const;
+MPMCD_INSTANTIATE(2)
+MPMCD_INSTANTIATE(3)
+#undef MPMCD_INSTANTIATE
+#undef MPMCD_INSTANTIATE_SHAPE
+
+}  // namespace mpmcd::mpm

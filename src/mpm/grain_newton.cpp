@@ -1,0 +1,284 @@
+// One Newton iteration of a grain (method.md §2): kinematics, law and residual (evaluate_grain),
+// the consistent tangent (assemble_tangent), the Newton matrix and its factorisation, the linear
+// solve and the modified-Newton reuse of a factorisation.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+
+#include "solver_detail.hpp"
+
+namespace mpmcd::mpm {
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
+  using Shape = typename grid::ShapeOf<Dim, S1>::type;
+  constexpr int K = Shape::K;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  const std::int64_t np = gr.size();
+  const std::size_t na = w.m.size();
+  const double theta = settings_.theta;
+  w.tangent_current = w.factor_current = false;
+  // Nodal increment du_I = dt [(1 - theta) v_I^n + theta v_I^{n+1}] (method.md §2).
+  for (std::size_t a = 0; a < na; ++a) w.du[a] = dt * ((1.0 - theta) * w.v_n[a] + theta * w.v[a]);
+  // Kinematics: dF = I + sum du_I (x) grad N_I(x^n), F^{n+1} = dF F^n, V^{n+1} = J V^0.
+  for (std::int64_t i = 0; i < np; ++i) {
+    const std::int64_t p = gr.begin + i;
+    Mat<Dim> dF = Mat<Dim>::Identity();
+    for (int a = 0; a < K; ++a) {
+      const std::int32_t n = w.pt_node[i * K + a];
+      if (n >= 0) dF += w.du[n] * w.pt_dN[i * K + a].transpose();
+    }
+    F_trial_[p] = dF * points_.F[p];
+    const double J = F_trial_[p].determinant();
+    J_trial_[p] = J;
+    if (!(J > 0.0) || !std::isfinite(J)) {
+      w.failure = fmt::format("J = {:.3g} <= 0 (inverted material point)", J);
+      w.fail_point = p;
+      return;
+    }
+    dF_inv_T_[p] = dF.inverse().transpose();
+  }
+  const materials::Law<Dim>& law = *laws_[gr.material];
+  const auto off = static_cast<std::size_t>(gr.begin);
+  const auto cnt = static_cast<std::size_t>(np);
+  const std::size_t hs = static_cast<std::size_t>(law.history_size());
+  materials::LawBatch<Dim> batch{
+      std::span<const Mat<Dim>>(F_trial_.data() + off, cnt),
+      std::span<const double>(points_.history.data() + gr.history_offset, hs * cnt),
+      std::span<double>(history_trial_.data() + gr.history_offset, hs * cnt),
+      std::span<Mat<Dim>>(sigma_trial_.data() + off, cnt),
+      std::span<Tensor4<Dim>>(tangent_.data() + off, cnt),
+      {},
+      Dim == 2 ? std::span<double>(sigma_zz_trial_.data() + off, cnt) : std::span<double>()};
+  law.evaluate(batch);
+  // Internal force f_I = -sum V sigma grad_{x^{n+1}} N_I with grad_{x^{n+1}} N = dF^-T grad_{x^n} N
+  // (seed eq. 5 at n+1, method.md §2).
+  std::fill(w.f_int.begin(), w.f_int.end(), Vec<Dim>::Zero());
+  std::fill(w.f_abs.begin(), w.f_abs.end(), Vec<Dim>::Zero());
+  for (std::int64_t i = 0; i < np; ++i) {
+    const std::int64_t p = gr.begin + i;
+    const Mat<Dim>& sig = sigma_trial_[p];
+    if (!sig.allFinite()) {
+      w.failure = "non-finite stress";
+      w.fail_point = p;
+      return;
+    }
+    const Mat<Dim> Vsig_dFinvT = J_trial_[p] * points_.volume0[p] * sig * dF_inv_T_[p];
+    for (int a = 0; a < K; ++a) {
+      const std::int32_t n = w.pt_node[i * K + a];
+      if (n < 0) continue;
+      const Vec<Dim> fa = Vsig_dFinvT * w.pt_dN[i * K + a];
+      w.f_int[n] -= fa;
+      w.f_abs[n] += fa.cwiseAbs();
+    }
+  }
+  // Residual R_I = m_I (v^{n+1} - v^n) - dt [(1 - theta) f^n + theta f^{n+1}] (method.md §2).
+  // Reference scale: inertia, nodal forces and the magnitude of the stress contributions, so that
+  // the tolerance stays above round-off when large point forces cancel at a node.
+  double r2 = 0, mv2 = 0, fn2 = 0, fi2 = 0, fe2 = 0, fa2 = 0, p2 = 0;
+  for (std::size_t a = 0; a < na; ++a) {
+    // ... - P_I: the contact impulse over the step (method.md §2, §4)
+    Vec<Dim> r = w.m[a] * (w.v[a] - w.v_n[a]) -
+                 dt * ((1.0 - theta) * w.f_n[a] + theta * (w.f_int[a] + w.f_ext[a])) - w.P[a];
+    for (int d = 0; d < Dim; ++d)
+      if (w.mask[a] & (1u << d)) r[d] = 0.0;
+    w.R[a] = r;
+    r2 += r.squaredNorm();
+    mv2 += (w.m[a] * w.v_n[a]).squaredNorm();
+    fn2 += w.f_n[a].squaredNorm();
+    fi2 += w.f_int[a].squaredNorm();
+    fe2 += w.f_ext[a].squaredNorm();
+    fa2 += w.f_abs[a].squaredNorm();
+    p2 += w.P[a].squaredNorm();
+  }
+  w.res_norm = std::sqrt(r2);
+  w.res_ref = std::sqrt(mv2) + std::sqrt(p2) +
+              dt * (std::sqrt(fn2) + std::sqrt(fi2) + std::sqrt(fe2) + std::sqrt(fa2));
+  if (!std::isfinite(w.res_norm)) {
+    w.failure = "non-finite residual";
+    return;
+  }
+  // Velocity scale of the increment test (mass norm): sqrt(sum m max(|v^{n+1}|^2, |v^n|^2)) plus
+  // the velocity change the step's forces and impulses can produce, res_ref / sqrt(M) (a body at
+  // rest has no velocity scale of its own). The convergence decision is taken in solve_step.
+  double vref2 = 0, mass = 0;
+  for (std::size_t a = 0; a < na; ++a) {
+    vref2 += w.m[a] * std::max(w.v[a].squaredNorm(), w.v_n[a].squaredNorm());
+    mass += w.m[a];
+  }
+  w.vel_ref = std::sqrt(vref2) + (mass > 0 ? w.res_ref / std::sqrt(mass) : 0.0);
+  w.evaluated = true;
+}
+
+template <int Dim>
+template <class S1>
+void ImplicitSolver<Dim>::assemble_tangent(std::size_t g) {
+  using Shape = typename grid::ShapeOf<Dim, S1>::type;
+  constexpr int K = Shape::K;
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  // Tangent blocks K_IJ,ik = sum V g_I,j a_ijkl g_J,l, g = dF^-T grad_{x^n} N (material +
+  // geometric, method.md §2), accumulated into the block stencil through the pair -> slot table.
+  std::fill(w.K_blk.begin(), w.K_blk.end(), Mat<Dim>::Zero());
+  Vec<Dim> gx[K];
+  Eigen::Matrix<double, Dim, Dim * Dim> Ma[K];
+  for (std::int64_t i = 0; i < gr.size(); ++i) {
+    const std::int64_t p = gr.begin + i;
+    const double V = J_trial_[p] * points_.volume0[p];
+    const Tensor4<Dim>& T = tangent_[p];
+    for (int a = 0; a < K; ++a) {
+      gx[a] = dF_inv_T_[p] * w.pt_dN[i * K + a];
+      if (w.pt_node[i * K + a] < 0) continue;
+      // Ma(i, kl) = V sum_j g_j a(ij, kl)
+      for (int ii = 0; ii < Dim; ++ii)
+        for (int kl = 0; kl < Dim * Dim; ++kl) {
+          double acc = 0;
+          for (int j = 0; j < Dim; ++j) acc += gx[a][j] * T(ii * Dim + j, kl);
+          Ma[a](ii, kl) = V * acc;
+        }
+    }
+    for (int a = 0; a < K; ++a) {
+      const std::int32_t na_ = w.pt_node[i * K + a];
+      if (na_ < 0) continue;
+      Mat<Dim>* row = &w.K_blk[static_cast<std::size_t>(na_) * w.S];
+      for (int b = 0; b < K; ++b) {
+        if (w.pt_node[i * K + b] < 0) continue;
+        Mat<Dim>& blk = row[w.pair_slot[a * K + b]];
+        for (int ii = 0; ii < Dim; ++ii)
+          for (int k = 0; k < Dim; ++k) {
+            double acc = 0;
+            for (int l = 0; l < Dim; ++l) acc += Ma[a](ii, k * Dim + l) * gx[b][l];
+            blk(ii, k) += acc;
+          }
+      }
+    }
+  }
+  w.tangent_current = true;
+}
+
+template <int Dim>
+bool ImplicitSolver<Dim>::factorize_grain(std::size_t g, double dt) {
+  GrainWork& w = *work_[g];
+  const std::size_t na = w.m.size();
+  const double c = settings_.theta * settings_.theta * dt * dt;
+  double* val = w.A.valuePtr();
+  // Newton matrix dR/dv^{n+1} = M + theta^2 dt^2 K (method.md §2); prescribed rows and columns
+  // are replaced by m_I on the diagonal so the matrix stays symmetric positive definite.
+  const int center = (w.S - 1) / 2;
+  for (std::size_t a = 0; a < na; ++a)
+    for (int s = 0; s < w.S; ++s) {
+      const std::int32_t b = w.stencil_nb[a * w.S + s];
+      if (b < 0) continue;
+      const Mat<Dim>& K = w.K_blk[a * w.S + s];
+      for (int i = 0; i < Dim; ++i)
+        for (int j = 0; j < Dim; ++j) {
+          double v = c * K(i, j);
+          if (s == center && i == j) v += w.m[a];
+          const bool fixed_row = w.mask[a] & (1u << i);
+          const bool fixed_col = w.mask[b] & (1u << j);
+          if (fixed_row || fixed_col) v = (s == center && i == j) ? w.m[a] : 0.0;
+          val[w.value_index[((a * w.S + s) * Dim + i) * Dim + j]] = v;
+        }
+    }
+  bool ok = true;
+  switch (settings_.linear_solver) {
+    case LinearSolverKind::kLdlt:
+      w.ldlt.factorize(w.A);
+      ok = w.ldlt.info() == Eigen::Success;
+      break;
+    case LinearSolverKind::kLu:
+      w.lu.factorize(w.A);
+      ok = w.lu.info() == Eigen::Success;
+      break;
+    case LinearSolverKind::kCg:
+      w.cg.setTolerance(settings_.cg_tolerance);
+      w.cg.setMaxIterations(settings_.cg_max_iterations);
+      w.cg.compute(w.A);
+      break;
+  }
+  if (!ok) w.failure = "linear solve failed (singular or indefinite tangent)";
+  w.factor_current = ok;
+  w.factor_in_step = ok;
+  ++w.factor_count;
+  ++w.factorizations;
+  return ok;
+}
+
+template <int Dim>
+template <class Rhs>
+Eigen::VectorXd ImplicitSolver<Dim>::linear_solve(std::size_t g, const Rhs& rhs) {
+  GrainWork& w = *work_[g];
+  switch (settings_.linear_solver) {
+    case LinearSolverKind::kLdlt:
+      return w.ldlt.solve(rhs);
+    case LinearSolverKind::kLu:
+      return w.lu.solve(rhs);
+    case LinearSolverKind::kCg: {
+      Eigen::VectorXd x = w.cg.solve(rhs);
+      if (w.cg.info() != Eigen::Success) x.setConstant(std::numeric_limits<double>::quiet_NaN());
+      return x;
+    }
+  }
+  return {};
+}
+
+template <int Dim>
+bool ImplicitSolver<Dim>::reuse_factor(const GrainWork& w) const {
+  // Modified Newton (Settings::modified_newton): the step's first factorisation serves all its
+  // iterations and contact updates, unless the residual stalls (falls by less than half over an
+  // iteration), when the tangent is rebuilt.
+  if (!settings_.modified_newton || !w.factor_in_step) return false;
+  const auto n = w.history.size();
+  return n < 2 || w.history[n - 1] < 0.5 * w.history[n - 2];
+}
+
+template <int Dim>
+void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt, bool reuse) {
+  GrainWork& w = *work_[g];
+  const std::size_t na = w.m.size();
+  if (!reuse && !factorize_grain(g, dt)) return;
+  w.rhs.resize(static_cast<Eigen::Index>(na * Dim));
+  for (std::size_t a = 0; a < na; ++a)
+    for (int d = 0; d < Dim; ++d) w.rhs[a * Dim + d] = -w.R[a][d];
+  w.sol = linear_solve(g, w.rhs);
+  w.cg_work = settings_.linear_solver == LinearSolverKind::kCg
+                  ? static_cast<double>(w.cg.iterations()) * static_cast<double>(w.A.nonZeros())
+                  : static_cast<double>(w.A.nonZeros());
+  if (!w.sol.allFinite()) {
+    w.failure = "linear solve failed (singular or indefinite tangent)";
+    return;
+  }
+  double dv2 = 0;
+  for (std::size_t a = 0; a < na; ++a) {
+    const Vec<Dim> dv = w.sol.template segment<Dim>(static_cast<Eigen::Index>(a * Dim));
+    w.v[a] += dv;
+    dv2 += w.m[a] * dv.squaredNorm();
+  }
+  w.dv_norm = std::sqrt(dv2);
+  w.solved_once = true;
+  ++w.solves;
+}
+
+// The members defined here, for each dimension and shape family (the class is instantiated in
+// solver.cpp); linear_solve also for the columns of the compliance (grain_compliance).
+#define MPMCD_INSTANTIATE_SHAPE(D, S1)                                      \
+  template void ImplicitSolver<D>::evaluate_grain<S1>(std::size_t, double); \
+  template void ImplicitSolver<D>::assemble_tangent<S1>(std::size_t);
+#define MPMCD_INSTANTIATE(D)                                                         \
+  MPMCD_FOR_EACH_SHAPE(MPMCD_INSTANTIATE_SHAPE, D)                                   \
+  template bool ImplicitSolver<D>::factorize_grain(std::size_t, double);             \
+  template Eigen::VectorXd ImplicitSolver<D>::linear_solve<Eigen::MatrixXd::ColXpr>( \
+      std::size_t, const Eigen::MatrixXd::ColXpr&);                                  \
+  template bool ImplicitSolver<D>::reuse_factor(const GrainWork&) const;             \
+  template void ImplicitSolver<D>::solve_grain(std::size_t, double, bool);
+MPMCD_INSTANTIATE(2)
+MPMCD_INSTANTIATE(3)
+#undef MPMCD_INSTANTIATE
+#undef MPMCD_INSTANTIATE_SHAPE
+
+}  // namespace mpmcd::mpm
