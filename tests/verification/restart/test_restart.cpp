@@ -252,7 +252,9 @@ TEST(Restart, SigkillLeavesALoadableCheckpoint) {
   EXPECT_EQ(wait_exit(pid), 128 + SIGKILL);
   const auto ckpts = ck::list(out.string(), "pair");
   ASSERT_FALSE(ckpts.empty());
-  EXPECT_LE(ckpts.size(), 3u);
+  // keep = 3, plus the newest when the kill falls between its rename and the pruning of the
+  // oldest (a checkpoint is pruned only once its successor is safe on disk).
+  EXPECT_LE(ckpts.size(), 4u);
   const ck::State s = ck::read(ckpts.back());  // throws if damaged
   EXPECT_EQ(s.step % 3, 0);
   const int rc =
