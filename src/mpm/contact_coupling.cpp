@@ -182,15 +182,8 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     static int written = 0;
     contact::write_problem(given, fmt::format("{}/stalled_{:04d}.txt", stalled_dir, written++));
   }
-  stats.gs_sweeps += r.sweeps;
-  stats.gs_error = r.error;
   gs_converged_ = r.converged;
-  double num = 0, den = 0;
-  for (std::size_t c = 0; c < old.size(); ++c) {
-    const auto& ct = problem_.contacts[c];
-    num += (ct.impulse - old[c]).squaredNorm();
-    den += ct.impulse.squaredNorm();
-  }
+  const auto [num, den] = detail::impulse_change(problem_, old, r, stats);
   const std::vector<Vec<Dim>> slot_p = contact::net_impulses(problem_);
   // The new impulses enter the grains' residuals; their velocities take the linearised response
   // (v += Z dP, or the lumped v = v_free + P/m), and a grain whose impulses changed iterates again.
@@ -236,14 +229,8 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   }
   if (!problem_.groups.empty()) spread_slot_impulses();
   for (std::size_t g = 0; g < work_.size(); ++g)
-    if (dv2[g] >= 0.0) {
-      work_[g]->converged = false;
-      work_[g]->solved_once = true;
-      work_[g]->dv_norm = std::sqrt(dv2[g]);
-    }
-  if (num == 0.0) return gs_converged_ ? 0.0 : 1.0;
-  const double change = std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
-  return gs_converged_ ? change : std::max(change, 1.0);
+    if (dv2[g] >= 0.0) work_[g]->impulses_changed(dv2[g]);
+  return detail::relative_change(num, den, gs_converged_);
 }
 
 // The members defined here (the class is instantiated in solver.cpp).

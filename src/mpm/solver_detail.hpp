@@ -4,8 +4,11 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mpmcd/grid/shape.hpp"
@@ -77,6 +80,12 @@ struct ImplicitSolver<Dim>::GrainWork {
   // Energy ledger terms of the step (StepStats): kinetic energy of the points before the step and
   // after its G2P, and of the grid field at v^n [J].
   double kin_points_n = 0, kin_points = 0, kin_grid_n = 0;
+  // The contact impulses changed the velocities by sqrt(dv2) in the mass norm: iterate again.
+  void impulses_changed(double dv2) {
+    converged = false;
+    solved_once = true;
+    dv_norm = std::sqrt(dv2);
+  }
 };
 
 namespace detail {
@@ -94,6 +103,31 @@ void with_shape(grid::ShapeKind kind, Fn&& fn) {
       fn(grid::Cpdi1D{});
       return;
   }
+}
+
+/// Records a Gauss-Seidel outcome in `stats` and returns the sums of the relative impulse change
+/// since `old` (the impulses before it), num = sum |P - P_old|^2, den = sum |P|^2 [(N s)^2].
+template <int Dim>
+std::pair<double, double> impulse_change(const contact::Problem<Dim>& problem,
+                                         const std::vector<Vec<Dim>>& old,
+                                         const contact::GsResult& r, StepStats& stats) {
+  stats.gs_sweeps += r.sweeps;
+  stats.gs_error = r.error;
+  double num = 0, den = 0;
+  for (std::size_t c = 0; c < old.size(); ++c) {
+    const auto& ct = problem.contacts[c];
+    num += (ct.impulse - old[c]).squaredNorm();
+    den += ct.impulse.squaredNorm();
+  }
+  return {num, den};
+}
+
+/// The staggering's relative impulse change sqrt(num / den) from impulse_change's sums, at least 1
+/// when Gauss-Seidel did not converge (0 without any change once converged) [-].
+inline double relative_change(double num, double den, bool gs_converged) {
+  if (num == 0.0) return gs_converged ? 0.0 : 1.0;
+  const double change = std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
+  return gs_converged ? change : std::max(change, 1.0);
 }
 }  // namespace detail
 

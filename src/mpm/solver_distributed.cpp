@@ -371,15 +371,8 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
     r.error = v[1];
     r.converged = v[2] == 0.0;
   }
-  stats.gs_sweeps += r.sweeps;
-  stats.gs_error = r.error;
   gs_converged_ = r.converged;
-  double num = 0, den = 0;
-  for (std::size_t c = 0; c < old.size(); ++c) {
-    const auto& ct = problem_.contacts[c];
-    num += (ct.impulse - old[c]).squaredNorm();
-    den += ct.impulse.squaredNorm();
-  }
+  auto [num, den] = detail::impulse_change(problem_, old, r, stats);
   const std::vector<Vec<Dim>> slot_p = contact::net_impulses(problem_);
   // 4. New impulses into the grains: own slots here, ghost slots sent back to their owners.
   std::vector<double> dv2(work_.size(), -1.0);
@@ -418,14 +411,8 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
     den = v[1];
   }
   for (std::size_t g : owned_)
-    if (dv2[g] >= 0.0) {
-      work_[g]->converged = false;
-      work_[g]->solved_once = true;
-      work_[g]->dv_norm = std::sqrt(dv2[g]);
-    }
-  if (num == 0.0) return gs_converged_ ? 0.0 : 1.0;
-  const double change = std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
-  return gs_converged_ ? change : std::max(change, 1.0);
+    if (dv2[g] >= 0.0) work_[g]->impulses_changed(dv2[g]);
+  return detail::relative_change(num, den, gs_converged_);
 }
 
 // The members defined here (the class is instantiated in solver.cpp).
