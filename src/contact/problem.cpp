@@ -82,13 +82,33 @@ void respond(const Problem<Dim>& p, std::vector<Vec<Dim>>& v, std::int32_t s, co
     v[g.slots[j]] += g.G.template block<Dim, Dim>(Dim * j, Dim * sl.local) * dP;
 }
 
+// Contacts above which the per-node work is shared among threads (lumped operator: a contact
+// costs a few hundred ns) and above which the work is shared when compliance groups couple the
+// nodes (a contact update costs a pass over its groups' slots).
+constexpr std::size_t kThreadedContacts = 1024;
+constexpr std::size_t kThreadedGroupContacts = 64;
+
+// Whether the sweeps and error sums of problem p run on the threads.
+template <int Dim>
+bool threaded_problem(const Problem<Dim>& p) {
+  return p.contacts.size() > (p.groups.empty() ? kThreadedContacts : kThreadedGroupContacts);
+}
+
 template <int Dim>
 std::vector<Vec<Dim>> slot_velocities(const Problem<Dim>& p) {
   std::vector<Vec<Dim>> v(p.slots.size());
   for (std::size_t s = 0; s < p.slots.size(); ++s) v[s] = p.slots[s].v_free;
   const auto net = net_impulses(p);
+  // A group's impulses move its own slots only: the groups on the threads, each summing its
+  // slots' responses in its slot order (the same bits for any thread count).
+  const auto ng = static_cast<std::int64_t>(p.groups.size());
+#pragma omp parallel for schedule(dynamic, 4) if (threaded_problem(p))
+  for (std::int64_t g = 0; g < ng; ++g)
+    for (const std::int32_t s : p.groups[g].slots)
+      if (net[s] != Vec<Dim>::Zero()) respond(p, v, s, net[s]);
   for (std::size_t s = 0; s < p.slots.size(); ++s)
-    if (net[s] != Vec<Dim>::Zero()) respond(p, v, static_cast<std::int32_t>(s), net[s]);
+    if (p.slots[s].group < 0 && net[s] != Vec<Dim>::Zero())
+      respond(p, v, static_cast<std::int32_t>(s), net[s]);
   return v;
 }
 
@@ -112,40 +132,83 @@ void free_velocity(const Problem<Dim>& p, const std::vector<Vec<Dim>>& v, const 
 namespace {
 
 // Contacts grouped by the node of their slot B, each group in the serial order, as runs of
-// `order` from start[r] to start[r + 1]. With the lumped operator (no compliance group) a slot
-// belongs to one node and responds to its own impulses only, so contacts of different nodes share
-// nothing: the sweep is a set of independent per-node sweeps (docs/parallel.md). One run holding
-// every contact when groups couple the nodes.
+// `order` from start[r] to start[r + 1]; runs of one phase (runs phase[k] to phase[k + 1]) share
+// no slot and no compliance group, so they are swept on the threads, the phases one after the
+// other. With the lumped operator (no compliance group) a slot belongs to one node and responds
+// to its own impulses only: one phase of independent per-node runs (docs/parallel.md). When
+// groups couple the nodes, each node's contacts are a run and the runs are coloured greedily, in
+// node order, so that no two runs of a colour touch the same group or lumped slot (multicolour
+// Gauss-Seidel): one phase per colour. Either way the result does not depend on the thread count.
 struct NodeRuns {
-  std::vector<std::int32_t> order, start;
+  std::vector<std::int32_t> order, start, phase;
 };
 
 template <int Dim>
-NodeRuns node_runs(const Problem<Dim>& p, bool node_blocks) {
+NodeRuns node_runs(const Problem<Dim>& p) {
   NodeRuns runs;
   const auto n = static_cast<std::int32_t>(p.contacts.size());
   runs.order.resize(static_cast<std::size_t>(n));
   for (std::int32_t c = 0; c < n; ++c) runs.order[c] = c;
-  runs.start.push_back(0);
   const auto node = [&](std::int32_t c) { return p.slots[p.contacts[c].b].node; };
-  if (!p.groups.empty()) {
-    // One run; with node blocks, its contacts ordered by node so that each node's are adjacent.
-    if (node_blocks)
-      std::stable_sort(runs.order.begin(), runs.order.end(),
-                       [&](std::int32_t x, std::int32_t y) { return node(x) < node(y); });
-    runs.start.push_back(n);
-    return runs;
-  }
   std::stable_sort(runs.order.begin(), runs.order.end(),
                    [&](std::int32_t x, std::int32_t y) { return node(x) < node(y); });
+  std::vector<std::int32_t> start{0};
   for (std::int32_t k = 1; k < n; ++k)
-    if (node(runs.order[k]) != node(runs.order[k - 1])) runs.start.push_back(k);
-  runs.start.push_back(n);
+    if (node(runs.order[k]) != node(runs.order[k - 1])) start.push_back(k);
+  start.push_back(n);
+  if (p.groups.empty()) {
+    runs.start = std::move(start);
+    runs.phase = {0, static_cast<std::int32_t>(runs.start.size()) - 1};
+    return runs;
+  }
+  // Resources of a slot: its group, or the slot itself when lumped (after the groups).
+  const auto resource = [&](std::int32_t s) {
+    return p.slots[s].group >= 0 ? p.slots[s].group
+                                 : static_cast<std::int32_t>(p.groups.size()) + s;
+  };
+  const std::size_t nres = p.groups.size() + p.slots.size();
+  const auto nruns = static_cast<std::int32_t>(start.size()) - 1;
+  std::vector<std::vector<char>> used(nres);  // used[resource][colour]
+  std::vector<std::int32_t> colour(static_cast<std::size_t>(nruns));
+  std::int32_t ncolours = 0;
+  std::vector<std::int32_t> res;
+  for (std::int32_t r = 0; r < nruns; ++r) {
+    res.clear();
+    for (std::int32_t k = start[r]; k < start[r + 1]; ++k) {
+      const Contact<Dim>& c = p.contacts[runs.order[k]];
+      res.push_back(resource(c.b));
+      if (c.a >= 0) res.push_back(resource(c.a));
+    }
+    std::int32_t col = 0;
+    for (;; ++col) {
+      bool free = true;
+      for (const std::int32_t q : res)
+        if (col < static_cast<std::int32_t>(used[q].size()) && used[q][col]) free = false;
+      if (free) break;
+    }
+    for (const std::int32_t q : res) {
+      if (static_cast<std::int32_t>(used[q].size()) <= col) used[q].resize(col + 1, 0);
+      used[q][col] = 1;
+    }
+    colour[r] = col;
+    ncolours = std::max(ncolours, col + 1);
+  }
+  // The runs colour by colour (node order within a colour), the contacts in their run's order.
+  std::vector<std::int32_t> order;
+  order.reserve(runs.order.size());
+  runs.start = {0};
+  runs.phase = {0};
+  for (std::int32_t col = 0; col < ncolours; ++col) {
+    for (std::int32_t r = 0; r < nruns; ++r)
+      if (colour[r] == col) {
+        for (std::int32_t k = start[r]; k < start[r + 1]; ++k) order.push_back(runs.order[k]);
+        runs.start.push_back(static_cast<std::int32_t>(order.size()));
+      }
+    runs.phase.push_back(static_cast<std::int32_t>(runs.start.size()) - 1);
+  }
+  runs.order = std::move(order);
   return runs;
 }
-
-// Contacts above which the per-node work is shared among threads.
-constexpr std::size_t kThreadedContacts = 1024;
 
 // One sweep: each contact solved exactly with the others' current impulses (method.md §4), in
 // the serial order within a node; the nodes on the threads (the same impulses for any count).
@@ -208,7 +271,14 @@ bool solve_node_block(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const std::int3
   // contact's scale |base_i| + W_ii |p_i|) is taken; an exact solution has none.
   VecK best;
   double best_violation = std::numeric_limits<double>::infinity();
-  for (int mask = 0; mask < (1 << k); ++mask) {
+  // The current active set first (Gauss-Seidel keeps it once converging: one solve), then the
+  // others in order.
+  int current = 0;
+  for (int i = 0; i < k; ++i)
+    if (p0[i] > 0) current |= 1 << i;
+  for (int trial = -1; trial < (1 << k); ++trial) {
+    if (trial == current) continue;
+    const int mask = trial < 0 ? current : trial;
     VecK q = VecK::Zero(k);
     int na = 0;
     std::array<int, kMaxBlock> act{};
@@ -221,7 +291,15 @@ bool solve_node_block(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const std::int3
         ra[i] = -base[act[i]];
         for (int j = 0; j < na; ++j) Wa(i, j) = W(act[i], act[j]);
       }
-      const VecK qa = Wa.completeOrthogonalDecomposition().solve(ra);
+      // LDL^T when W_AA is safely positive definite, else the minimum-norm solution (redundant
+      // contacts make it singular).
+      VecK qa;
+      const auto ldlt = Wa.ldlt();
+      if (ldlt.info() == Eigen::Success && ldlt.isPositive() &&
+          ldlt.vectorD().minCoeff() > 1e-8 * ldlt.vectorD().maxCoeff())
+        qa = ldlt.solve(ra);
+      else
+        qa = Wa.completeOrthogonalDecomposition().solve(ra);
       if (!qa.allFinite()) continue;
       for (int i = 0; i < na; ++i) q[act[i]] = qa[i];
     }
@@ -256,35 +334,36 @@ bool solve_node_block(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const std::int3
 template <int Dim>
 void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, StageTimers* timers,
            double omega, bool node_blocks) {
-  const auto nr = static_cast<std::int64_t>(runs.start.size()) - 1;
-  const ThreadedRegion threaded(timers, p.contacts.size() > kThreadedContacts);
-#pragma omp parallel for schedule(dynamic, 64) if (p.contacts.size() > kThreadedContacts)
-  for (std::int64_t r = 0; r < nr; ++r)
-    for (std::int32_t k = runs.start[r], block_end = k; k < runs.start[r + 1]; ++k) {
-      if (node_blocks && k >= block_end) {  // the next node's contacts [k, block_end)
-        const std::int64_t node = p.slots[p.contacts[runs.order[k]].b].node;
-        block_end = k + 1;
-        while (block_end < runs.start[r + 1] &&
-               p.slots[p.contacts[runs.order[block_end]].b].node == node)
-          ++block_end;
-        if (solve_node_block(p, v, runs.order.data() + k, block_end - k)) {
-          k = block_end - 1;
-          continue;
+  const bool threads = threaded_problem(p);
+  const ThreadedRegion threaded(timers, threads);
+  for (std::size_t ph = 0; ph + 1 < runs.phase.size(); ++ph)
+#pragma omp parallel for schedule(dynamic, 8) if (threads)
+    for (std::int64_t r = runs.phase[ph]; r < runs.phase[ph + 1]; ++r)
+      for (std::int32_t k = runs.start[r], block_end = k; k < runs.start[r + 1]; ++k) {
+        if (node_blocks && k >= block_end) {  // the next node's contacts [k, block_end)
+          const std::int64_t node = p.slots[p.contacts[runs.order[k]].b].node;
+          block_end = k + 1;
+          while (block_end < runs.start[r + 1] &&
+                 p.slots[p.contacts[runs.order[block_end]].b].node == node)
+            ++block_end;
+          if (solve_node_block(p, v, runs.order.data() + k, block_end - k)) {
+            k = block_end - 1;
+            continue;
+          }
         }
+        Contact<Dim>& c = p.contacts[runs.order[k]];
+        Vec<Dim> u;
+        Mat<Dim> W;
+        free_velocity(p, v, c, u, W);
+        Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
+        if (omega != 1.0 && c.friction == 0.0)  // projected SOR on the normal cone p_n >= 0
+          P = project_cone<Dim>(c.impulse + omega * (P - c.impulse), c.normal, 0.0);
+        const Vec<Dim> dP = P - c.impulse;
+        if (dP == Vec<Dim>::Zero()) continue;
+        respond(p, v, c.b, dP);
+        if (c.a >= 0) respond(p, v, c.a, Vec<Dim>(-dP));
+        c.impulse = P;
       }
-      Contact<Dim>& c = p.contacts[runs.order[k]];
-      Vec<Dim> u;
-      Mat<Dim> W;
-      free_velocity(p, v, c, u, W);
-      Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
-      if (omega != 1.0 && c.friction == 0.0)  // projected SOR on the normal cone p_n >= 0
-        P = project_cone<Dim>(c.impulse + omega * (P - c.impulse), c.normal, 0.0);
-      const Vec<Dim> dP = P - c.impulse;
-      if (dP == Vec<Dim>::Zero()) continue;
-      respond(p, v, c.b, dP);
-      if (c.a >= 0) respond(p, v, c.a, Vec<Dim>(-dP));
-      c.impulse = P;
-    }
 }
 
 // The sweeps until error() <= tolerance or max_sweeps, error() giving the (global) error.
@@ -297,7 +376,7 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& 
     return r;
   }
   auto v = slot_velocities(p);
-  const NodeRuns runs = node_runs(p, settings.node_blocks);
+  const NodeRuns runs = node_runs(p);
   while (r.sweeps < settings.max_sweeps) {
     sweep(p, v, runs, settings.timers, r.sweeps >= settings.relax_after ? settings.relaxation : 1.0,
           settings.node_blocks);
@@ -325,8 +404,8 @@ void error_terms(const Problem<Dim>& p, double& num, double& den, StageTimers* t
   const auto n = static_cast<std::int64_t>(p.contacts.size());
   std::vector<double> tn(static_cast<std::size_t>(n)), td(static_cast<std::size_t>(n));
   {
-    const ThreadedRegion threaded(timers, p.contacts.size() > kThreadedContacts);
-#pragma omp parallel for schedule(static) if (p.contacts.size() > kThreadedContacts)
+    const ThreadedRegion threaded(timers, threaded_problem(p));
+#pragma omp parallel for schedule(static) if (threaded_problem(p))
     for (std::int64_t i = 0; i < n; ++i) {
       const Contact<Dim>& c = p.contacts[i];
       Vec<Dim> u;
