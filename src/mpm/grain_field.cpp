@@ -296,7 +296,8 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
 template <int Dim>
 template <class S1>
 typename ImplicitSolver<Dim>::G2P ImplicitSolver<Dim>::g2p_point(const GrainWork& w, std::int64_t p,
-                                                                 std::int64_t i) const {
+                                                                 std::int64_t i,
+                                                                 bool with_grad) const {
   constexpr int K = grid::ShapeOf<Dim, S1>::type::K;
   const double alpha = settings_.flip;
   Vec<Dim> dx = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero(), vpic = Vec<Dim>::Zero();
@@ -308,7 +309,7 @@ typename ImplicitSolver<Dim>::G2P ImplicitSolver<Dim>::g2p_point(const GrainWork
     dx += N * w.du[n];
     dv += N * (w.v[n] - w.v_p2g[n]);
     vpic += N * w.v[n];
-    if (settings_.affine) grad_v += w.v[n] * w.pt_dN[i * K + a].transpose();
+    if (with_grad) grad_v += w.v[n] * w.pt_dN[i * K + a].transpose();
   }
   // v_p = flip (v_p + sum N dv) + (1 - flip) sum N v (method.md §2).
   return {dx, alpha * (points_.v[p] + dv) + (1.0 - alpha) * vpic, grad_v};
@@ -321,7 +322,7 @@ void ImplicitSolver<Dim>::commit_grain(std::size_t g) {
   const GrainWork& w = *work_[g];
   for (std::int64_t i = 0; i < gr.size(); ++i) {
     const std::int64_t p = gr.begin + i;
-    const G2P u = g2p_point<S1>(w, p, i);
+    const G2P u = g2p_point<S1>(w, p, i, settings_.affine);
     // Velocity gradient at x^{n+1} for the next affine P2G: grad_{x^n} v dF^-1 (Settings::affine).
     if (settings_.affine) points_.L[p] = u.grad_v * dF_inv_T_[p].transpose();
     // G2P: x_p += sum N du (method.md §2).
@@ -345,7 +346,7 @@ void ImplicitSolver<Dim>::check_next_positions(std::size_t g) {
   w.kin_points = 0;
   for (std::int64_t i = 0; i < gr.size(); ++i) {
     const std::int64_t p = gr.begin + i;
-    const G2P u = g2p_point<S1>(w, p, i);  // as commit_grain: the same position and velocity
+    const G2P u = g2p_point<S1>(w, p, i, false);  // commit_grain's position and velocity
     w.kin_points += 0.5 * points_.mass[p] * u.v.squaredNorm();
     const Vec<Dim> x = points_.x[p] + u.dx;
     // A domain stretched too far is left to the next step's set-up (a retryable failure there);

@@ -248,13 +248,14 @@ class ImplicitSolver {
   void exchange_requests();
   double update_contacts_distributed(StepStats& stats);
   // G2P of point p, the i-th of its grain (method.md §2): position increment sum N du, new velocity
-  // flip (v_p + sum N (v - v_p2g)) + (1 - flip) sum N v, and velocity gradient sum v (x) grad N.
+  // flip (v_p + sum N (v - v_p2g)) + (1 - flip) sum N v, and (if with_grad) the velocity gradient
+  // sum v (x) grad N, else zero.
   struct G2P {
     Vec<Dim> dx, v;
     Mat<Dim> grad_v;
   };
   template <class S1>
-  G2P g2p_point(const GrainWork& w, std::int64_t p, std::int64_t i) const;
+  G2P g2p_point(const GrainWork& w, std::int64_t p, std::int64_t i, bool with_grad) const;
   template <class S1>
   void commit_grain(std::size_t g);
   // Fails grain g's step (not retryable) if a point's position after it, x + sum N du, would put
