@@ -91,12 +91,7 @@ void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   // matrix. Column (j, d) of E is sum_k w_jk e_{a_jk, d} (one node of weight 1 for a node slot).
   GrainWork& w = *work_[g];
   if (!w.lumped_group) {
-    if (!reuse_factor(w)) {
-      if (!w.tangent_current) {
-        detail::with_shape(settings_.shape, [&](auto tag) { assemble_tangent<decltype(tag)>(g); });
-      }
-      if (!w.factor_current && !factorize_grain(g, dt_)) return;
-    }
+    if (!reuse_factor(w) && !prepare_factor(g, dt_)) return;
     // Z and G depend only on the factorisation and the slots (fixed within a step).
     if (w.z_factor == w.factor_count) return;
     w.z_factor = w.factor_count;

@@ -37,6 +37,8 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   w.fail_point = -1;
   w.history.clear();
   w.factor_in_step = false;
+  w.project_tangent = false;
+  w.projections = 0;
   w.z_factor = -1;
   w.pt_first.resize(np);
   w.pt_N.resize(np * K);

@@ -115,6 +115,22 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
   w.evaluated = true;
 }
 
+namespace {
+
+// The tangent a_ijkl of a point as a symmetric Dim^2 x Dim^2 matrix, with its negative
+// eigenvalues set to zero (projected Newton, Teran et al. 2005): returns `a` itself when it is
+// positive semi-definite, else the projection, written to `scratch`.
+template <int Dim>
+const Tensor4<Dim>& projected(const Tensor4<Dim>& a, Tensor4<Dim>& scratch) {
+  const Eigen::SelfAdjointEigenSolver<Tensor4<Dim>> es(a);
+  if (es.eigenvalues()[0] >= 0) return a;
+  scratch = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() *
+            es.eigenvectors().transpose();
+  return scratch;
+}
+
+}  // namespace
+
 template <int Dim>
 template <class S1>
 void ImplicitSolver<Dim>::assemble_tangent(std::size_t g) {
@@ -124,13 +140,16 @@ void ImplicitSolver<Dim>::assemble_tangent(std::size_t g) {
   const points::Grain& gr = grains_[g];
   // Tangent blocks K_IJ,ik = sum V g_I,j a_ijkl g_J,l, g = dF^-T grad_{x^n} N (material +
   // geometric, method.md §2), accumulated into the block stencil through the pair -> slot table.
+  // With project_tangent each point's a is first projected onto the positive semi-definite
+  // matrices (prepare_factor).
   std::fill(w.K_blk.begin(), w.K_blk.end(), Mat<Dim>::Zero());
   Vec<Dim> gx[K];
   Eigen::Matrix<double, Dim, Dim * Dim> Ma[K];
+  Tensor4<Dim> Tp;  // the projected tangent of the current point
   for (std::int64_t i = 0; i < gr.size(); ++i) {
     const std::int64_t p = gr.begin + i;
     const double V = J_trial_[p] * points_.volume0[p];
-    const Tensor4<Dim>& T = tangent_[p];
+    const Tensor4<Dim>& T = w.project_tangent ? projected<Dim>(tangent_[p], Tp) : tangent_[p];
     for (int a = 0; a < K; ++a) {
       gx[a] = dF_inv_T_[p] * w.pt_dN[i * K + a];
       if (w.pt_node[i * K + a] < 0) continue;
@@ -210,6 +229,32 @@ bool ImplicitSolver<Dim>::factorize_grain(std::size_t g, double dt) {
 }
 
 template <int Dim>
+bool ImplicitSolver<Dim>::prepare_factor(std::size_t g, double dt) {
+  GrainWork& w = *work_[g];
+  if (w.factor_current) return true;
+  const auto assemble = [&] {
+    detail::with_shape(settings_.shape, [&](auto tag) { assemble_tangent<decltype(tag)>(g); });
+  };
+  if (!w.tangent_current) assemble();
+  if (!factorize_grain(g, dt)) return false;
+  // Under compression the geometric term delta_ik sigma_jl makes a point's tangent indefinite
+  // (on rotations), and modes that strain no point (edge nodes of a block, rigid rotation) then
+  // give M + theta^2 dt^2 K negative eigenvalues once dt^2 |sigma| / h^2 exceeds the nodal
+  // density: the contact compliance E^T A^-1 E is indefinite and Gauss-Seidel diverges
+  // (docs/accuracy.md). A grain whose factorisation gives a compliance then uses the projected
+  // tangent for the step; the Newton iterations still converge to the same state, linearly. A
+  // grain without contact keeps the exact tangent (quadratic convergence).
+  if (w.project_tangent || w.slots.empty() || w.lumped_group ||
+      settings_.linear_solver != LinearSolverKind::kLdlt ||
+      !laws_[grains_[g].material]->symmetric_tangent() || (w.ldlt.vectorD().array() > 0).all())
+    return true;
+  w.project_tangent = true;
+  ++w.projections;
+  assemble();
+  return factorize_grain(g, dt);
+}
+
+template <int Dim>
 template <class Rhs>
 Eigen::VectorXd ImplicitSolver<Dim>::linear_solve(std::size_t g, const Rhs& rhs) {
   GrainWork& w = *work_[g];
@@ -241,7 +286,7 @@ template <int Dim>
 void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt, bool reuse) {
   GrainWork& w = *work_[g];
   const std::size_t na = w.m.size();
-  if (!reuse && !factorize_grain(g, dt)) return;
+  if (!reuse && !prepare_factor(g, dt)) return;
   w.rhs.resize(static_cast<Eigen::Index>(na * Dim));
   for (std::size_t a = 0; a < na; ++a)
     for (int d = 0; d < Dim; ++d) w.rhs[a * Dim + d] = -w.R[a][d];
@@ -272,6 +317,7 @@ void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt, bool reuse) {
 #define MPMCD_INSTANTIATE(D)                                                         \
   MPMCD_FOR_EACH_SHAPE(MPMCD_INSTANTIATE_SHAPE, D)                                   \
   template bool ImplicitSolver<D>::factorize_grain(std::size_t, double);             \
+  template bool ImplicitSolver<D>::prepare_factor(std::size_t, double);              \
   template Eigen::VectorXd ImplicitSolver<D>::linear_solve<Eigen::MatrixXd::ColXpr>( \
       std::size_t, const Eigen::MatrixXd::ColXpr&);                                  \
   template bool ImplicitSolver<D>::reuse_factor(const GrainWork&) const;             \

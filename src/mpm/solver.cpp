@@ -227,12 +227,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         const std::size_t g = owned_[i];
         GrainWork& w = *work_[g];
         if (w.converged || !w.failure.empty()) continue;
-        const bool reuse = reuse_factor(w);
-        if (!reuse && !w.tangent_current) {
-          detail::with_shape(settings_.shape,
-                             [&](auto tag) { assemble_tangent<decltype(tag)>(g); });
-        }
-        solve_grain(g, dt, reuse);
+        solve_grain(g, dt, reuse_factor(w));
         const double u = kCgWorkWeight * w.cg_work;
         phase_work(g, it) += u;
         units += u;
@@ -249,6 +244,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.iterations = std::max(stats.iterations, work_[g]->iterations);
     stats.linear_solves += work_[g]->solves;
     stats.factorizations += work_[g]->factorizations;
+    stats.projected_factorizations += work_[g]->projections;
   }
   if (!stats.converged) {
     for (std::size_t g : owned_)
@@ -341,7 +337,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   if (dist) {  // sums over the ranks' contacts, added in rank order
     ScopedStage tc(&timers_, "newton.check.comm");
     std::vector<std::int64_t> n{stats.contacts, stats.active_contacts, stats.linear_solves,
-                                stats.factorizations};
+                                stats.factorizations, stats.projected_factorizations};
     comm_->sum(n);
     std::vector<std::int64_t> it{-stats.iterations};
     comm_->min(it);
@@ -349,6 +345,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.active_contacts = n[1];
     stats.linear_solves = n[2];
     stats.factorizations = n[3];
+    stats.projected_factorizations = n[4];
     stats.iterations = static_cast<int>(-it[0]);
     if (nw > 0) comm_->sum(wall_f);  // one rank holds each grain's wall contacts: exact
   }

@@ -49,6 +49,8 @@ struct ImplicitSolver<Dim>::GrainWork {
   bool z_forward = false;           // Z holds Y = L^-1 P E instead (LDL^T: grain_compliance)
   bool tangent_current = false, factor_current = false;  // K_blk / factorisation match v
   bool factor_in_step = false;            // a factorisation of this step's Newton matrix exists
+  bool project_tangent = false;           // this step assembles the projected (PSD) tangent
+  std::int64_t projections = 0;           // factorisations redone projected in the current step
   std::int64_t factor_count = 0;          // factorisations so far (identifies the current one)
   std::int64_t z_factor = -1;             // the factorisation Z and G were computed with (-1: none)
   double vel_ref = 0;                     // velocity scale of the increment test [sqrt(kg) m/s]

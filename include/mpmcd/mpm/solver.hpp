@@ -117,6 +117,9 @@ struct StepStats {
   int iterations = 0;               ///< Newton iterations (max over grains)
   std::int64_t linear_solves = 0;   ///< linear solves, summed over grains
   std::int64_t factorizations = 0;  ///< Newton-matrix factorisations, summed over grains
+  /// Factorisations redone with the projected tangent because M + theta^2 dt^2 K was indefinite
+  /// (docs/accuracy.md, "Indefinite Newton matrices"), summed over grains [-].
+  std::int64_t projected_factorizations = 0;
   /// Work of the contact impulses on the grains over the step, sum_I P_I . (v_I^n + v_I^{n+1}) / 2
   /// over every grain node (the exact kinetic-energy change they cause on the grid) [J] (2D: J/m).
   double contact_work = 0;
@@ -221,6 +224,9 @@ class ImplicitSolver {
   template <class S1>
   void assemble_tangent(std::size_t g);
   bool factorize_grain(std::size_t g, double dt);
+  /// Assembles (if stale) and factorises grain g's Newton matrix; an indefinite LDL^T is redone
+  /// with the projected tangent (assemble_tangent). False on a failed factorisation.
+  bool prepare_factor(std::size_t g, double dt);
   template <class Rhs>
   Eigen::VectorXd linear_solve(std::size_t g, const Rhs& rhs);
   void solve_grain(std::size_t g, double dt, bool reuse);
