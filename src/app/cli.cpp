@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "mpmcd/app/analyze.hpp"
+#include "mpmcd/app/model_builder.hpp"
 #include "mpmcd/app/simulation.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
