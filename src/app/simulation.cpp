@@ -11,270 +11,22 @@
 #include <csignal>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <map>
-#include <regex>
 
 #include "mpmcd/app/compaction_observer.hpp"
 #include "mpmcd/app/model_builder.hpp"
+#include "mpmcd/app/outputs.hpp"
 #include "mpmcd/app/progress.hpp"
+#include "mpmcd/app/run_folder.hpp"
 #include "mpmcd/app/speed_check.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/load_config.hpp"
-#include "mpmcd/io/output_folder.hpp"
-#include "mpmcd/io/vtu.hpp"
 #include "mpmcd/parallel/distribute.hpp"
 #include "mpmcd/version.hpp"
 
 namespace mpmcd::app {
 
 namespace fs = std::filesystem;
-
-namespace {
-
-// Writes one VTU snapshot of the points.
-void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {
-  const auto& p = model.points;
-  io::VtuPointCloud vtu(p.size());
-  auto& vel = vtu.add_array("velocity", 3);
-  auto& sig = vtu.add_array("stress", 9);
-  auto& pres = vtu.add_array("pressure", 1);
-  auto& jac = vtu.add_array("J", 1);
-  auto& mass = vtu.add_array("mass", 1);
-  auto& vol = vtu.add_array("volume", 1);
-  auto& grain = vtu.add_int_array("grain");
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    vtu.set_position(i, p.x[i][0], p.x[i][1]);
-    vel[3 * i] = p.v[i][0];
-    vel[3 * i + 1] = p.v[i][1];
-    const Mat<2>& s = p.sigma[i];
-    const double s3[9] = {s(0, 0), s(0, 1), 0, s(1, 0), s(1, 1), 0, 0, 0, p.sigma_zz[i]};
-    for (int k = 0; k < 9; ++k) sig[9 * i + k] = s3[k];
-    pres[i] = -(s(0, 0) + s(1, 1) + p.sigma_zz[i]) / 3.0;  // p = -tr(sigma)/3 (plane strain)
-    jac[i] = p.F[i].determinant();
-    mass[i] = p.mass[i];
-    vol[i] = p.volume[i];
-    grain[i] = p.grain[i];
-  }
-  vtu.write(path);
-}
-
-// Keeps the header and the first `rows` complete rows of the CSV at `path` (drops the rows
-// written after a checkpoint and a torn last line); returns the rows kept.
-std::int64_t trim_csv(const std::string& path, std::int64_t rows) {
-  std::ifstream in(path, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::size_t end = 0;
-  std::int64_t kept = -1;  // the header is line 0
-  while (kept < rows) {
-    const std::size_t nl = text.find('\n', end);
-    if (nl == std::string::npos) break;
-    end = nl + 1;
-    ++kept;
-  }
-  io::write_file_atomic(path, text.substr(0, end));
-  return std::max<std::int64_t>(kept, 0);
-}
-
-class Outputs {
- public:
-  // `extra_header`: further CSV columns (CompactionObserver), starting with a comma; `restart`:
-  // the checkpoint a restarted run continues (nullptr: a new run); `history`: the checkpoint's
-  // folder when the restart writes to another folder ("" otherwise), from which the outputs
-  // written before the checkpoint are copied so that the new folder holds the whole run.
-  Outputs(const io::Config& cfg, const std::string& dir, const std::string& extra_header,
-          const checkpoint::State* restart, const std::string& history = "")
-      : cfg_(cfg), dir_(dir) {
-    fs::create_directories(dir_);
-    if (restart && !history.empty()) copy_history(history, *restart);
-    // Input copy, stamped with the version that ran it.
-    io::write_file_atomic(
-        (fs::path(dir_) / "input.toml").string(),
-        fmt::format("# run by mpmcd {} ({}) from {}\n", kVersion, kGitHash, cfg.source_path) +
-            cfg.source_text);
-    csv_path_ = (fs::path(dir_) / (cfg.simulation.name + ".csv")).string();
-    std::string header =
-        "step,time,dt,newton_iterations,linear_solves,kinetic_energy,elastic_energy,"
-        "total_energy,momentum_x,momentum_y,mass,volume,contacts,active_contacts,gs_sweeps";
-    for (const auto& w : cfg.walls) header += ",wall_" + w.name + "_fx,wall_" + w.name + "_fy";
-    header += extra_header + "\n";
-    if (restart && fs::exists(csv_path_)) {
-      csv_rows_ = trim_csv(csv_path_, restart->csv_rows);
-      if (csv_rows_ < restart->csv_rows)
-        log().warn("{} holds {} of the {} rows written before the checkpoint", csv_path_, csv_rows_,
-                   restart->csv_rows);
-      csv_rows_ = restart->csv_rows;
-      csv_.open(csv_path_, std::ios::binary | std::ios::app);
-    } else {
-      if (restart) log().warn("{} is missing: it restarts at step {}", csv_path_, restart->step);
-      csv_rows_ = restart ? restart->csv_rows : 0;
-      csv_.open(csv_path_, std::ios::binary | std::ios::trunc);
-      write_row(header);
-    }
-    if (!csv_) throw std::runtime_error("cannot open " + csv_path_);
-    if (cfg_.output.vtu)
-      pvd_ = std::make_unique<io::PvdSeries>(
-          (fs::path(dir_) / (cfg.simulation.name + ".pvd")).string());
-    if (restart && pvd_) {  // the series so far: file names follow from the snapshot index
-      int missing = 0;
-      for (const double t : restart->vtu_times) {
-        // Only snapshots that are in this folder: a series never lists a missing file.
-        const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
-        if (fs::exists(fs::path(dir_) / name))
-          pvd_->restore(t, name);
-        else
-          ++missing;
-        vtu_times_.push_back(t);
-        ++vtu_count_;
-      }
-      if (missing > 0)
-        log().warn(
-            "{} of the {} snapshots written before the checkpoint are not in {}: the .pvd "
-            "series lists the {} that are",
-            missing, vtu_count_, dir_, vtu_count_ - missing);
-    }
-  }
-  // Copies the outputs written up to the checkpoint from its folder `from`: the CSV (trimmed
-  // later to the checkpoint's rows) and every snapshot (points, contacts, pairs) it lists.
-  void copy_history(const std::string& from, const checkpoint::State& restart) {
-    const std::string& name = cfg_.simulation.name;
-    std::vector<std::string> files{name + ".csv"};
-    for (std::size_t k = 0; k < restart.vtu_times.size(); ++k)
-      for (const char* f : {"{}_{:06d}.vtu", "{}_contacts_{:06d}.vtu", "{}_pairs_{:06d}.csv"})
-        files.push_back(fmt::format(fmt::runtime(f), name, k));
-    int copied = 0;
-    for (const auto& f : files) {
-      const fs::path src = fs::path(from) / f, dst = fs::path(dir_) / f;
-      std::error_code ec;
-      if (!fs::is_regular_file(src, ec)) continue;
-      const fs::path tmp = dst.string() + ".tmp";  // atomic, as every output
-      fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
-      if (!ec) fs::rename(tmp, dst, ec);
-      if (ec)
-        throw std::runtime_error(
-            fmt::format("cannot copy '{}' to '{}': {}", src.string(), dst.string(), ec.message()));
-      ++copied;
-    }
-    log().info("restart into {}: copied {} files written before the checkpoint from {}", dir_,
-               copied, from);
-  }
-  // Restores the contact series of a restart (only runs with contact write it).
-  void restore_contacts(const mpm::ImplicitSolver<2>& solver) {
-    if (!pvd_ || !solver.settings().contact.enabled) return;
-    contacts_pvd_ = std::make_unique<io::PvdSeries>(
-        (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
-    for (std::size_t k = 0; k < vtu_times_.size(); ++k) {
-      const std::string name = fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, k);
-      if (fs::exists(fs::path(dir_) / name)) contacts_pvd_->restore(vtu_times_[k], name);
-    }
-  }
-  void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& st,
-               const mpm::Diagnostics<2>& d, const std::string& extra) {
-    std::string row = fmt::format(
-        "{},{:.12e},{:.6e},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", step, t,
-        dt, st.iterations, st.linear_solves, d.kinetic, d.elastic, d.kinetic + d.elastic,
-        d.momentum[0], d.momentum[1], d.mass, d.volume);
-    row += fmt::format(",{},{},{}", st.contacts, st.active_contacts, st.gs_sweeps);
-    for (std::size_t k = 0; k < cfg_.walls.size(); ++k) {
-      const bool have = k < st.wall_force.size();
-      row += fmt::format(",{:.12e},{:.12e}", have ? st.wall_force[k][0] : 0.0,
-                         have ? st.wall_force[k][1] : 0.0);
-    }
-    row += extra + "\n";
-    write_row(row);
-    ++csv_rows_;
-  }
-  void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
-           const contact::Problem<2>& problem, double t) {
-    if (!pvd_) return;
-    const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
-    write_points_vtu(model, (fs::path(dir_) / name).string());
-    if (solver.settings().contact.enabled) {
-      const std::string cname =
-          fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
-      const std::string pname =
-          fmt::format("{}_pairs_{:06d}.csv", cfg_.simulation.name, vtu_count_);
-      write_contacts(model, problem, (fs::path(dir_) / cname).string(),
-                     (fs::path(dir_) / pname).string());
-      if (!contacts_pvd_)
-        contacts_pvd_ = std::make_unique<io::PvdSeries>(
-            (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
-      contacts_pvd_->add(t, cname);
-    }
-    pvd_->add(t, name);  // last: a series lists only snapshots whose files are complete
-    vtu_times_.push_back(t);
-    ++vtu_count_;
-  }
-  /// CSV rows written so far (header excluded).
-  std::int64_t csv_rows() const { return csv_rows_; }
-  /// Times of the VTU snapshots written so far [s].
-  const std::vector<double>& vtu_times() const { return vtu_times_; }
-  const std::string& dir() const { return dir_; }
-  // Contacts as points at their nodes (normal, impulses, the two bodies; walls as -1 - index),
-  // and the per-pair aggregated contact force sum P / dt as a CSV.
-  void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& pb,
-                      const std::string& vtu_path, const std::string& csv_path) {
-    io::VtuPointCloud vtu(pb.contacts.size());
-    auto& normal = vtu.add_array("normal", 3);
-    auto& pn = vtu.add_array("normal_impulse", 1);
-    auto& pt = vtu.add_array("tangential_impulse", 1);
-    auto& force = vtu.add_array("force", 3);
-    auto& gap = vtu.add_array("gap", 1);
-    auto& body_a = vtu.add_int_array("body_a");
-    auto& body_b = vtu.add_int_array("body_b");
-    std::map<std::pair<int, int>, Vec<2>> pairs;
-    const double inv_dt = pb.dt > 0 ? 1.0 / pb.dt : 0.0;
-    for (std::size_t i = 0; i < pb.contacts.size(); ++i) {
-      const auto& c = pb.contacts[i];
-      const auto& sb = pb.slots[c.b];
-      const Vec<2> x = model.grid.node_position(model.grid.node_coords(sb.node));
-      vtu.set_position(i, x[0], x[1]);
-      normal[3 * i] = c.normal[0];
-      normal[3 * i + 1] = c.normal[1];
-      pn[i] = c.impulse.dot(c.normal);
-      pt[i] = c.impulse[1] * c.normal[0] - c.impulse[0] * c.normal[1];  // along t = e_z x n
-      force[3 * i] = c.impulse[0] * inv_dt;
-      force[3 * i + 1] = c.impulse[1] * inv_dt;
-      gap[i] = c.gap;
-      body_a[i] = c.a >= 0 ? pb.slots[c.a].grain : -1 - c.wall;
-      body_b[i] = sb.grain;
-      // try_emplace with an explicit zero: Eigen vectors are not zero-initialised.
-      pairs.try_emplace({body_a[i], body_b[i]}, Vec<2>::Zero()).first->second += c.impulse * inv_dt;
-    }
-    vtu.write(vtu_path);
-    std::string text = "body_a,body_b,force_x,force_y\n";
-    for (const auto& [key, f] : pairs)
-      text += fmt::format("{},{},{:.12e},{:.12e}\n", key.first, key.second, f[0], f[1]);
-    io::write_file_atomic(csv_path, text);
-  }
-  std::string last_good(const mpm::Model<2>& model) {
-    const std::string path = (fs::path(dir_) / (cfg_.simulation.name + "_last_good.vtu")).string();
-    write_points_vtu(model, path);
-    return path;
-  }
-
- private:
-  const io::Config& cfg_;
-  std::string dir_, csv_path_;
-  // One whole row per write, flushed: a crash leaves complete rows (a torn last line, possible
-  // only if the disk fills up, is dropped on restart).
-  void write_row(const std::string& row) {
-    csv_.write(row.data(), static_cast<std::streamsize>(row.size()));
-    csv_.flush();
-    if (!csv_)
-      throw std::runtime_error(fmt::format("cannot write '{}': {}", csv_path_,
-                                           std::strerror(errno)));  // e.g. no space left
-  }
-
-  std::ofstream csv_;
-  std::unique_ptr<io::PvdSeries> pvd_, contacts_pvd_;
-  int vtu_count_ = 0;
-  std::int64_t csv_rows_ = 0;
-  std::vector<double> vtu_times_;
-};
-
-}  // namespace
 
 namespace {
 
@@ -376,67 +128,6 @@ mpm::Model<2> restore_model(const io::Config& cfg, const checkpoint::State& s,
   return model;
 }
 
-// The files of the run named `name` in `folder` (docs/robustness.md, "Output folders"): the
-// input copy and every output named after the run, with the .tmp files a crash may leave.
-std::vector<std::string> run_files(const std::string& folder, const std::string& name) {
-  const std::regex own("(input\\.toml|" + io::regex_escape(name) +
-                       "(\\.csv|\\.pvd|_contacts\\.pvd|_[0-9]{6}\\.vtu|_contacts_[0-9]{6}\\.vtu|"
-                       "_pairs_[0-9]{6}\\.csv|_checkpoint_[0-9]{9}\\.h5|_last_good\\.vtu|"
-                       "_timers\\.csv))(\\.tmp)?");
-  return io::files_in(folder, [&](const std::string& f) { return std::regex_match(f, own); });
-}
-
-// The run name in an input copy (<folder>/input.toml) of an earlier run: [simulation] name, by
-// default "mpmcd"; "" if the file cannot be read.
-std::string earlier_run_name(const fs::path& input_copy) {
-  std::ifstream in(input_copy);
-  if (!in) return "";
-  const std::regex table(R"re(\s*\[\s*([A-Za-z0-9_.]+)\s*\].*)re");
-  const std::regex key(R"re(\s*name\s*=\s*"([A-Za-z0-9_.-]+)".*)re");
-  std::string line, section, name = io::Config{}.simulation.name;
-  std::smatch m;
-  while (std::getline(in, line)) {
-    if (std::regex_match(line, m, table))
-      section = m[1];
-    else if (section == "simulation" && std::regex_match(line, m, key))
-      name = m[1];
-  }
-  return name;
-}
-
-// One folder, one run: a new run (or a restart written elsewhere than its checkpoint's folder)
-// refuses a folder that holds input.toml or files of a run of this name, unless `overwrite`,
-// which removes them, and those of the run named in the old input.toml, first. Rank 0 looks and
-// tells the others.
-void claim_run_folder(const io::Config& cfg, const RunOptions& opt, const std::string& dir,
-                      const parallel::Comm& comm) {
-  std::vector<char> verdict;
-  if (comm.rank() == 0) {
-    try {
-      auto files = run_files(dir, cfg.simulation.name);
-      const std::string earlier = earlier_run_name(fs::path(dir) / "input.toml");
-      if (opt.overwrite && !earlier.empty() && earlier != cfg.simulation.name)
-        for (auto& f : run_files(dir, earlier)) files.push_back(f);
-      std::sort(files.begin(), files.end());
-      files.erase(std::unique(files.begin(), files.end()), files.end());
-      const std::string what =
-          earlier.empty() || earlier == cfg.simulation.name
-              ? fmt::format("run named '{}'", cfg.simulation.name)
-              : fmt::format("run (named '{}', this one '{}')", earlier, cfg.simulation.name);
-      io::claim_output_folder(dir, files, opt.overwrite, what,
-                              opt.restart.empty() ? cfg.source_path : opt.restart,
-                              opt.output_dir.empty() ? "output.folder" : "-o");
-      if (opt.overwrite && !files.empty())
-        log().info("--overwrite: removed {} files of the earlier run in {}", files.size(), dir);
-    } catch (const InputError& e) {
-      const std::string m = e.what();
-      verdict.assign(m.begin(), m.end());
-    }
-  }
-  if (comm.size() > 1) comm.broadcast(verdict, 0);
-  if (!verdict.empty()) throw InputError(std::string(verdict.begin(), verdict.end()));
-}
-
 }  // namespace
 
 Restart load_restart(const std::string& path, const std::string& input) {
@@ -469,31 +160,16 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   bool any_moving = false;
   for (const auto& b : cfg.boundaries) any_moving = any_moving || b.moving;
 
-  summary.output_dir = opt.output_dir.empty() ? cfg.output.folder : opt.output_dir;
-  if (restart && opt.output_dir.empty()) {  // continue where the checkpoint lies
-    const fs::path parent = fs::path(opt.restart).parent_path();
-    summary.output_dir = parent.empty() ? "." : parent.string();
-  } else if (fs::path(summary.output_dir).is_relative() && opt.output_dir.empty()) {
-    summary.output_dir =
-        (fs::path(cfg.source_path).parent_path() / summary.output_dir).lexically_normal().string();
-  }
+  summary.output_dir = output_folder(cfg, opt, restart != nullptr);
   const CompactionObserver observer(cfg, model);
   // Processes (docs/parallel.md): every rank holds the model and computes its grains; rank 0
   // gathers the state at output and checkpoint times and writes every file.
   const auto& comm = parallel::Comm::world();
   const bool root = comm.rank() == 0;
   if (!root) log().set_level(spdlog::level::off);  // rank 0 reports
-  std::string history_dir;  // a restart written elsewhere: the checkpoint's folder
-  {  // a restart continues in its checkpoint's folder; anywhere else the folder must be free
-    std::error_code ec;
-    const fs::path ckpt_dir = restart ? (fs::path(opt.restart).parent_path().empty()
-                                             ? fs::path(".")
-                                             : fs::path(opt.restart).parent_path())
-                                      : fs::path();
-    const bool continuing = restart && fs::equivalent(ckpt_dir, summary.output_dir, ec);
-    if (!continuing) claim_run_folder(cfg, opt, summary.output_dir, comm);
-    if (restart && !continuing) history_dir = ckpt_dir.string();
-  }
+  // A restart written elsewhere than its checkpoint: the checkpoint's folder, its history.
+  const std::string history_dir =
+      prepare_output_folder(cfg, opt, summary.output_dir, restart != nullptr, comm);
   SignalGuard signals;
   mpm::ImplicitSolver<2> solver(model.grid, settings, model.points, model.grains, model.law_ptrs());
   solver.set_boundary_conditions(build_boundaries(cfg, model.grid, 0.0));
