@@ -18,6 +18,7 @@
 #include "mpmcd/app/progress.hpp"
 #include "mpmcd/app/run_folder.hpp"
 #include "mpmcd/app/speed_check.hpp"
+#include "mpmcd/app/step_controller.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/load_config.hpp"
@@ -262,13 +263,12 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
       kVersion, kGitHash, model.grains.size(), model.points.size(), model.grid.cells()[0],
       model.grid.cells()[1], model.grid.cell_size(), comm.size(), omp_get_max_threads());
   const double dt_nominal = cfg.time.dt, t_end = cfg.time.end_time;
-  double t = 0, dt = dt_nominal;
-  std::int64_t good_since_cut = 0;
+  double t = 0;
+  StepController dt_control(cfg.time);  // the step: cut on failure, restored after good steps
   double next_vtu = 0, next_csv = 0;
   if (restart) {
     t = restart->time;
-    dt = restart->dt;
-    good_since_cut = restart->good_since_cut;
+    dt_control.restore(restart->dt, restart->good_since_cut);
     next_vtu = restart->next_vtu;
     next_csv = restart->next_csv;
     summary.steps = restart->step;
@@ -311,7 +311,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     if (csv) {
       if (root) {
         const auto d = mpm::diagnostics(model);
-        out_ptr->csv_row(summary.steps, t, dt, last, d,
+        out_ptr->csv_row(summary.steps, t, dt_control.dt(), last, d,
                          observer.csv_fields(model, last, problem, t) + ledger_fields(d));
       }
       next_csv = t + cfg.output.csv_interval;
@@ -342,8 +342,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     s.reason = reason;
     s.step = summary.steps;
     s.time = t;
-    s.dt = dt;
-    s.good_since_cut = good_since_cut;
+    s.dt = dt_control.dt();
+    s.good_since_cut = dt_control.good_since_cut();
     s.failed_steps = summary.failed_steps;
     s.newton_iterations = summary.newton_iterations;
     s.next_vtu = next_vtu;
@@ -438,14 +438,13 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   };
   if (!opt.quiet) progress.add(progress_sample(last, 0.0).first);
   while (t < t_end - 1e-9 * dt_nominal) {
-    const double dt_try = std::min(dt, t_end - t);
+    const double dt_try = dt_control.next(t_end - t);
     solver.set_time(t);
     if (any_moving) solver.set_boundary_conditions(build_boundaries(cfg, model.grid, t + dt_try));
     mpm::StepStats st = solver.solve_step(dt_try);
     if (!st.converged) {  // the same verdict on every rank (the solver reduces it)
       ++summary.failed_steps;
-      const double dt_new = dt_try * cfg.time.cut_factor;
-      if (!st.retryable || dt_new < cfg.time.dt_min) {
+      if (!st.retryable || !dt_control.cut(dt_try)) {
         if (comm.size() > 1) gather_state(0);
         const std::string saved = root ? out_ptr->last_good(model) : std::string();
         // Step summary.steps + 1 failed; the state of step summary.steps (time t) is the last
@@ -470,9 +469,7 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
         throw NumericalError(reason, summary.steps + 1, t, st.grain, st.point);
       }
       log().warn("step {} at t = {:.9g} s failed ({}), retrying with dt = {:.4g} s",
-                 summary.steps + 1, t, st.failure, dt_new);
-      dt = dt_new;
-      good_since_cut = 0;
+                 summary.steps + 1, t, st.failure, dt_control.dt());
       continue;
     }
     solver.commit();
@@ -505,11 +502,8 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
     t += dt_try;
     ++summary.steps;
     summary.newton_iterations += st.iterations;
-    if (dt < dt_nominal && ++good_since_cut >= cfg.time.recover_steps) {
-      dt = std::min(dt_nominal, 2 * dt);
-      good_since_cut = 0;
-      log().info("dt restored to {:.4g} s at t = {:.9g} s", dt, t);
-    }
+    if (dt_control.succeeded())
+      log().info("dt restored to {:.4g} s at t = {:.9g} s", dt_control.dt(), t);
     // [stop] criteria. Phi needs every grain's area: on several ranks each one's grains, summed
     // per grain over the ranks (exact: the other ranks add zeros), then over the grains in
     // order, as one process does.
