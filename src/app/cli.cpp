@@ -8,6 +8,7 @@
 
 #include "mpmcd/app/analyze.hpp"
 #include "mpmcd/app/model_builder.hpp"
+#include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/simulation.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"

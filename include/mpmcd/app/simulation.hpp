@@ -41,18 +41,6 @@ struct RunSummary {
   int signal = 0;                      ///< signal that interrupted the run (0: none)
 };
 
-/// A checkpoint and the input of the run it continues.
-struct Restart {
-  io::Config config;        ///< the validated input
-  checkpoint::State state;  ///< the state to continue from
-  std::string path;         ///< the checkpoint file
-};
-
-/// Reads checkpoint `path` (refused with InputError if damaged) and the input it continues:
-/// `input` if not empty (its text must be the one the checkpoint was written from), else the input
-/// text stored in the checkpoint. Throws InputError (exit 2).
-Restart load_restart(const std::string& path, const std::string& input);
-
 /// Runs the whole simulation, from t = 0 or from `restart` (options.restart names its file);
 /// throws InputError (exit 2) or NumericalError (exit 3, after writing the last good state and
 /// its checkpoint). SIGINT/SIGTERM finish the current step, write a checkpoint and return with
