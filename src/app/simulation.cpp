@@ -25,6 +25,7 @@
 #include "mpmcd/io/vtu.hpp"
 #include "mpmcd/parallel/distribute.hpp"
 #include "mpmcd/version.hpp"
+#include "run.hpp"
 
 namespace mpmcd::app {
 
@@ -32,39 +33,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// SIGINT / SIGTERM: the handler only records the signal; the loop finishes its step, writes a
-// checkpoint and returns. SA_RESETHAND: a second signal gets the default action (stops at once).
+// The last SIGINT or SIGTERM caught while a SignalGuard is alive (0: none); Run::between_steps
+// acts on it after the step.
 volatile std::sig_atomic_t g_signal = 0;
 
 extern "C" void on_stop_signal(int sig) {
   g_signal = sig;
 }
 
-class SignalGuard {
- public:
-  SignalGuard() {
-    g_signal = 0;
-    struct sigaction sa = {};
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESETHAND;
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~SignalGuard() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  SignalGuard(const SignalGuard&) = delete;
-  SignalGuard& operator=(const SignalGuard&) = delete;
-
- private:
-  struct sigaction old_int_ = {}, old_term_ = {};
-};
-
 const char* signal_name(int sig) {
   return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal";
 }
+
 // The model of the run, after the thread count is set (a packing input runs its DEM on the
 // threads): restored from the checkpoint `restart`, or built from the input.
 mpm::Model<2> initial_model(const io::Config& cfg, const RunOptions& opt,
@@ -89,58 +69,24 @@ RunState<2> start_state(const io::Config& cfg, const mpm::Model<2>& model) {
   return s;
 }
 
-// One run: its model and solver, its outputs and its counters. Processes (docs/parallel.md):
-// every rank holds the model and computes its grains; rank 0 gathers the state at output and
-// checkpoint times and writes every file.
-class Run {
- public:
-  // Builds or restores everything (may throw InputError: before any output is written), then
-  // writes the outputs' headers.
-  Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* restart);
-  // Steps to the end (or a [stop] criterion, a signal, --stop-after); returns the summary.
-  RunSummary go();
+}  // namespace
 
- private:
-  void distribute();
-  void gather_state();
-  void record(bool force);
-  RunState<2> state_now();
-  std::string write_checkpoint(const std::string& reason);
-  [[noreturn]] void fail(const mpm::StepStats& st);
-  void commit(const mpm::StepStats& st, double dt);
-  void rebalance();
-  std::optional<std::string> stop_criterion(const mpm::StepStats& st);
-  bool between_steps(const mpm::StepStats& st, bool at_end);
-  std::pair<ProgressSample, std::optional<CompactionObserver::Now>> progress_sample(
-      const mpm::StepStats& st, double wall);
-  void report_progress(const mpm::StepStats& st, double wall);
-  RunSummary finish();
+namespace detail {
 
-  const io::Config& cfg_;
-  const RunOptions& opt_;
-  const checkpoint::State* restart_;  // the checkpoint continued (nullptr: a new run)
-  mpm::Model<2> model_;
-  const mpm::Settings<2> settings_;
-  const CompactionObserver observer_;
-  RunState<2> start_;  // where this invocation starts (t = 0, or the checkpoint's state)
-  const parallel::Comm& comm_;
-  const bool root_;
-  const parallel::Scheme scheme_;
-  const bool any_moving_, stop_active_;
-  RunSummary summary_;
-  std::optional<SignalGuard> signals_;
-  std::unique_ptr<mpm::ImplicitSolver<2>> solver_;
-  EnergyLedger<2> ledger_;
-  std::unique_ptr<Outputs> out_;  // rank 0 only
-  StepController dt_control_;
-  ProgressEstimator progress_;
-  double t_, next_vtu_, next_csv_;  // simulated time, of the next VTU and CSV output [s]
-  const std::int64_t steps0_;       // steps committed before this invocation [-]
-  std::int64_t last_checkpoint_step_;
-  mpm::StepStats last_;  // the last converged step
-  bool fast_points_reported_ = false;
-  std::chrono::steady_clock::time_point wall0_, last_progress_, last_checkpoint_wall_;
-};
+SignalGuard::SignalGuard() {
+  g_signal = 0;
+  struct sigaction sa = {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &sa, &old_int_);
+  sigaction(SIGTERM, &sa, &old_term_);
+}
+
+SignalGuard::~SignalGuard() {
+  sigaction(SIGINT, &old_int_, nullptr);
+  sigaction(SIGTERM, &old_term_, nullptr);
+}
 
 Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* restart)
     : cfg_(cfg),
@@ -228,115 +174,6 @@ void Run::distribute() {
   }
 }
 
-// Rank 0 gathers every grain's points (collective).
-void Run::gather_state() {
-  ScopedStage ts(&solver_->timers(), "output");
-  parallel::gather_points(comm_, model_.points, model_.grains, solver_->owner(), 0);
-}
-
-// The CSV row and the VTU snapshot of the committed state, when due or `force`d (collective).
-void Run::record(bool force) {
-  const double eps = 1e-9 * cfg_.time.dt;
-  const bool csv = force || t_ >= next_csv_ - eps, vtu = force || t_ >= next_vtu_ - eps;
-  if (!csv && !vtu) return;
-  if (comm_.size() > 1) gather_state();
-  if (root_ && !fast_points_reported_)
-    if (const auto w = fast_point_warning(cfg_, model_, t_)) {
-      log().warn("{}", *w);
-      fast_points_reported_ = true;
-    }
-  ScopedStage ts(&solver_->timers(), "output");
-  const auto problem = parallel::gather_contacts(comm_, solver_->contact_problem(), 0);
-  if (csv) {
-    if (root_) {
-      const auto d = mpm::diagnostics(model_);
-      out_->csv_row(summary_.steps, t_, dt_control_.dt(), last_, d,
-                    observer_.csv_fields(model_, last_, problem, t_) + ledger_.csv_fields(d));
-    }
-    next_csv_ = t_ + cfg_.output.csv_interval;
-  }
-  if (vtu) {
-    if (root_) out_->vtu(model_, *solver_, problem, t_);
-    next_vtu_ = t_ + cfg_.output.vtu_interval;
-  }
-}
-
-// The run's state besides the model, as a checkpoint holds it (on rank 0; the warm start and the
-// work counts are gathered by write_checkpoint).
-RunState<2> Run::state_now() {
-  RunState<2> s;
-  s.step = summary_.steps;
-  s.time = t_;
-  s.dt = dt_control_.dt();
-  s.good_since_cut = dt_control_.good_since_cut();
-  s.failed_steps = summary_.failed_steps;
-  s.newton_iterations = summary_.newton_iterations;
-  s.next_vtu = next_vtu_;
-  s.next_csv = next_csv_;
-  s.csv_rows = out_->csv_rows();
-  s.vtu_times = out_->vtu_times();
-  for (const auto& w : settings_.contact.walls) s.wall_points.push_back(w.point + t_ * w.velocity);
-  s.energy = ledger_.sums();
-  s.ranks = comm_.size();
-  s.scheme = parallel::to_string(scheme_);
-  s.threads = omp_get_max_threads();
-  s.grain_owner.assign(model_.grains.size(), 0);
-  if (comm_.size() > 1)
-    for (std::size_t g = 0; g < model_.grains.size(); ++g) s.grain_owner[g] = solver_->owner()[g];
-  return s;
-}
-
-// Writes the checkpoint of the committed state (collective: rank 0 gathers every grain and
-// every rank's warm-start impulses and writes one file); returns its path on rank 0.
-std::string Run::write_checkpoint(const std::string& reason) {
-  ScopedStage ts(&solver_->timers(), "checkpoint");
-  if (comm_.size() > 1) gather_state();
-  // Warm-start impulses of every rank (each contact is solved by one rank).
-  auto warm = solver_->gather_warm_start();
-  std::vector<double> work = solver_->grain_work();
-  work.resize(model_.grains.size() * parallel::kWorkPhases, 0.0);
-  comm_.sum(work);
-  last_checkpoint_step_ = summary_.steps;
-  if (!root_) return std::string();
-  RunState<2> run = state_now();
-  run.warm = std::move(warm);
-  run.grain_work = std::move(work);
-  const checkpoint::State s = to_checkpoint(cfg_, model_, run, reason);
-  const std::string path =
-      (fs::path(out_->dir()) / checkpoint::file_name(cfg_.simulation.name, s.step)).string();
-  checkpoint::write(s, path);
-  checkpoint::prune(out_->dir(), cfg_.simulation.name, cfg_.checkpoint.keep);
-  summary_.checkpoint = path;
-  log().info("checkpoint ({}) at step {}, t = {:.9g} s: {}", reason, s.step, t_, path);
-  return path;
-}
-
-// The step after summary_.steps failed for good (not retryable, or dt at dt_min): writes the last
-// good state and its checkpoint, and throws NumericalError.
-void Run::fail(const mpm::StepStats& st) {
-  const std::int64_t good = summary_.steps;
-  if (comm_.size() > 1) gather_state();
-  const std::string saved = root_ ? out_->last_good(model_) : std::string();
-  // Step good + 1 failed; the state of step good (time t) is the last good one: committed steps
-  // always keep every point's support on the grid (the solver checks the positions a step would
-  // commit), so its checkpoint can be resumed.
-  log().error("step {} failed; last good state (step {}, t = {:.9g} s) written to {}", good + 1,
-              good, t_, saved);
-  std::string ckpt;
-  try {
-    ckpt = write_checkpoint("failure");
-  } catch (const std::exception& e) {
-    log().error("no checkpoint of the last good state: {}", e.what());
-  }
-  std::string reason = st.retryable
-                           ? fmt::format("{}; dt cut down to dt_min = {:.3g} s did not help",
-                                         st.failure, dt_control_.dt_min())
-                           : st.failure;
-  reason += fmt::format(" in step {}, after the last good step {}", good + 1, good);
-  if (!ckpt.empty()) reason += fmt::format("; checkpoint of the last good step: {}", ckpt);
-  throw NumericalError(reason, good + 1, t_, st.grain, st.point);
-}
-
 // Commits the converged step of length dt [s]: points, energy ledger, re-balancing, counters.
 void Run::commit(const mpm::StepStats& st, double dt) {
   solver_->commit();
@@ -416,44 +253,6 @@ bool Run::between_steps(const mpm::StepStats& st, bool at_end) {
   return true;
 }
 
-// Progress toward the criterion that will end the run (docs/robustness.md, "Progress"): the
-// compaction state of the committed step (collective: the grains' area is summed over ranks).
-std::pair<ProgressSample, std::optional<CompactionObserver::Now>> Run::progress_sample(
-    const mpm::StepStats& st, double wall) {
-  ProgressSample s{wall, t_, std::nullopt, std::nullopt, std::nullopt};
-  if (!observer_.has_box()) return {s, std::nullopt};
-  std::vector<double> areas = CompactionObserver::grain_areas(
-      model_, comm_.size() > 1 ? &solver_->owner() : nullptr, comm_.rank());
-  if (comm_.size() > 1) comm_.sum(areas);
-  const auto now = observer_.now(CompactionObserver::total_area(areas), st, t_);
-  s.phi = now->phi;
-  s.strain = now->strain;
-  if (!st.wall_force.empty()) s.stress = -now->bottom_stress;  // none before the first step
-  return {s, now};
-}
-
-// The progress line after the committed step `st`, `wall` [s] after this invocation started.
-void Run::report_progress(const mpm::StepStats& st, double wall) {
-  const auto [sample, state] = progress_sample(st, wall);
-  progress_.add(sample);
-  std::optional<double> z;
-  if (settings_.contact.enabled)
-    z = observer_.coordination(parallel::gather_contacts(comm_, solver_->contact_problem(), 0));
-  const auto e = progress_.estimate();
-  std::string observed;
-  if (state)
-    observed = fmt::format("  Phi = {:.4f}  sigma_top = {:.4g} Pa", state->phi, state->top_stress);
-  if (z) observed += fmt::format("  Z = {:.3f}", *z);
-  const double rate = static_cast<double>(summary_.steps - steps0_) / std::max(wall, 1e-30);
-  log().info(
-      "step {:>7}  t = {:.6e} s ({:5.1f}% of {} = {:.6g}{}){}  newton {}  {:.1f} steps/s  ETA {}",
-      summary_.steps, t_, 100 * e.fraction, e.criterion, e.target,
-      e.criterion == "end_time"      ? " s"
-      : e.criterion == "stop.stress" ? " Pa"
-                                     : "",
-      observed, st.iterations, rate, format_eta(e.eta));
-}
-
 RunSummary Run::go() {
   if (!restart_) record(true);
   comm_.record_syncs();  // the serial fraction, measured at every synchronisation
@@ -527,11 +326,11 @@ RunSummary Run::finish() {
   return summary_;
 }
 
-}  // namespace
+}  // namespace detail
 
 RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                           const checkpoint::State* restart) {
-  return Run(cfg, opt, restart).go();
+  return detail::Run(cfg, opt, restart).go();
 }
 
 }  // namespace mpmcd::app
