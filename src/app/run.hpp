@@ -60,7 +60,7 @@ class Run {
   // run_records.cpp: what the run writes.
   void gather_state();
   void record(bool force);
-  RunState<2> state_now();
+  checkpoint::State state_now(const std::string& reason);
   std::string write_checkpoint(const std::string& reason);
   [[noreturn]] void fail(const mpm::StepStats& st);
   std::pair<ProgressSample, std::optional<CompactionObserver::Now>> progress_sample(
@@ -73,7 +73,6 @@ class Run {
   mpm::Model<2> model_;
   const mpm::Settings<2> settings_;
   const CompactionObserver observer_;
-  RunState<2> start_;  // where this invocation starts (t = 0, or the checkpoint's state)
   const parallel::Comm& comm_;
   const bool root_;
   const parallel::Scheme scheme_;

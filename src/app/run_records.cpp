@@ -49,10 +49,11 @@ void Run::record(bool force) {
   }
 }
 
-// The run's state besides the model, as a checkpoint holds it (on rank 0; the warm start and the
-// work counts are gathered by write_checkpoint).
-RunState<2> Run::state_now() {
-  RunState<2> s;
+// The run's counters, as its checkpoint written for `reason` holds them (on rank 0; the model,
+// the warm start and the work counts are added by write_checkpoint).
+checkpoint::State Run::state_now(const std::string& reason) {
+  checkpoint::State s;
+  s.reason = reason;
   s.step = summary_.steps;
   s.time = t_;
   s.dt = dt_control_.dt();
@@ -63,8 +64,7 @@ RunState<2> Run::state_now() {
   s.next_csv = next_csv_;
   s.csv_rows = out_->csv_rows();
   s.vtu_times = out_->vtu_times();
-  for (const auto& w : settings_.contact.walls) s.wall_points.push_back(w.point + t_ * w.velocity);
-  s.energy = ledger_.sums();
+  store_energy(ledger_.sums(), s);
   s.ranks = comm_.size();
   s.scheme = parallel::to_string(scheme_);
   s.threads = omp_get_max_threads();
@@ -80,16 +80,15 @@ std::string Run::write_checkpoint(const std::string& reason) {
   ScopedStage ts(&solver_->timers(), "checkpoint");
   if (comm_.size() > 1) gather_state();
   // Warm-start impulses of every rank (each contact is solved by one rank).
-  auto warm = solver_->gather_warm_start();
+  const auto warm = solver_->gather_warm_start();
   std::vector<double> work = solver_->grain_work();
   work.resize(model_.grains.size() * parallel::kWorkPhases, 0.0);
   comm_.sum(work);
   last_checkpoint_step_ = summary_.steps;
   if (!root_) return std::string();
-  RunState<2> run = state_now();
-  run.warm = std::move(warm);
-  run.grain_work = std::move(work);
-  const checkpoint::State s = to_checkpoint(cfg_, model_, run, reason);
+  checkpoint::State s = state_now(reason);
+  s.grain_work = std::move(work);
+  store_run(cfg_, model_, warm, settings_.contact.walls, s);
   const std::string path =
       (fs::path(out_->dir()) / checkpoint::file_name(cfg_.simulation.name, s.step)).string();
   checkpoint::write(s, path);

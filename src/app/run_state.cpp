@@ -11,22 +11,27 @@ namespace mpmcd::app {
 namespace {
 
 // checkpoint::State's flat point-major arrays: a vector per point as its Dim components, a matrix
-// per point as its Dim x Dim components row by row (x[p * Dim + a], F[(p * Dim + a) * Dim + b]).
+// per point as its Dim x Dim components row by row (x[p * Dim + a], F[(p * Dim + a) * Dim + b]);
+// per-point scalars and the history as they are. put: model -> checkpoint, take: the reverse
+// (`n` points).
 template <int Dim>
-std::vector<double> flatten(const std::vector<Vec<Dim>>& in) {
-  std::vector<double> out(Dim * in.size());
+void put(const std::vector<Vec<Dim>>& in, std::vector<double>& out) {
+  out.assign(Dim * in.size(), 0.0);
   for (std::size_t p = 0; p < in.size(); ++p)
     for (int a = 0; a < Dim; ++a) out[p * Dim + a] = in[p][a];
-  return out;
 }
 
 template <int Dim>
-std::vector<double> flatten(const std::vector<Mat<Dim>>& in) {
-  std::vector<double> out(Dim * Dim * in.size());
+void put(const std::vector<Mat<Dim>>& in, std::vector<double>& out) {
+  out.assign(Dim * Dim * in.size(), 0.0);
   for (std::size_t p = 0; p < in.size(); ++p)
     for (int a = 0; a < Dim; ++a)
       for (int b = 0; b < Dim; ++b) out[(p * Dim + a) * Dim + b] = in[p](a, b);
-  return out;
+}
+
+template <typename T>
+void put(const std::vector<T>& in, std::vector<T>& out) {
+  out = in;
 }
 
 template <int Dim>
@@ -37,114 +42,118 @@ Vec<Dim> vec_at(const std::vector<double>& in, std::size_t p) {
 }
 
 template <int Dim>
-std::vector<Vec<Dim>> vectors(const std::vector<double>& in, std::size_t n) {
-  std::vector<Vec<Dim>> out(n);
+void take(const std::vector<double>& in, std::vector<Vec<Dim>>& out, std::size_t n) {
+  out.resize(n);
   for (std::size_t p = 0; p < n; ++p) out[p] = vec_at<Dim>(in, p);
-  return out;
 }
 
 template <int Dim>
-std::vector<Mat<Dim>> matrices(const std::vector<double>& in, std::size_t n) {
-  std::vector<Mat<Dim>> out(n);
+void take(const std::vector<double>& in, std::vector<Mat<Dim>>& out, std::size_t n) {
+  out.resize(n);
   for (std::size_t p = 0; p < n; ++p)
     for (int a = 0; a < Dim; ++a)
       for (int b = 0; b < Dim; ++b) out[p](a, b) = in[(p * Dim + a) * Dim + b];
-  return out;
+}
+
+template <typename T>
+void take(const std::vector<T>& in, std::vector<T>& out, std::size_t) {
+  out = in;
+}
+
+// Each field of points::PointSet with the checkpoint array that holds it: f(&PointSet::field,
+// &State::array) for every one, listed once for writing and reading.
+template <int Dim, typename F>
+void for_each_point_field(F&& f) {
+  using P = points::PointSet<Dim>;
+  using S = checkpoint::State;
+  f(&P::x, &S::x);
+  f(&P::v, &S::v);
+  f(&P::L, &S::L);
+  f(&P::F, &S::F);
+  f(&P::sigma, &S::sigma);
+  f(&P::domain, &S::domain);
+  f(&P::sigma_zz, &S::sigma_zz);
+  f(&P::mass, &S::mass);
+  f(&P::volume0, &S::volume0);
+  f(&P::volume, &S::volume);
+  f(&P::grain, &S::grain);
+  f(&P::history, &S::history);
+}
+
+// Each field of points::Grain with the checkpoint array (one entry per grain) that holds it.
+template <typename F>
+void for_each_grain_field(F&& f) {
+  using G = points::Grain;
+  using S = checkpoint::State;
+  f(&G::begin, &S::grain_begin);
+  f(&G::end, &S::grain_end);
+  f(&G::material, &S::grain_material);
+  f(&G::half_width, &S::grain_half_width);
+  f(&G::history_offset, &S::grain_history_offset);
+}
+
+// Each of the energy ledger's sums with the checkpoint field that holds it.
+template <typename F>
+void for_each_energy_field(F&& f) {
+  using E = EnergySums;
+  using S = checkpoint::State;
+  f(&E::wall_work, &S::wall_work);
+  f(&E::energy0, &S::energy0);
+  f(&E::kinetic0, &S::kinetic0);
+  f(&E::contact_dissipation, &S::contact_dissipation);
+  f(&E::transfer_dissipation, &S::transfer_dissipation);
+  f(&E::stress_work, &S::stress_work);
+  f(&E::body_work, &S::body_work);
 }
 
 }  // namespace
 
 template <int Dim>
-checkpoint::State to_checkpoint(const io::Config& cfg, const mpm::Model<Dim>& model,
-                                const RunState<Dim>& run, const std::string& reason) {
-  checkpoint::State s;
+void store_run(const io::Config& cfg, const mpm::Model<Dim>& model,
+               const std::vector<mpm::WarmImpulse<Dim>>& warm,
+               const std::vector<mpm::Wall<Dim>>& walls, checkpoint::State& s) {
   s.dim = Dim;
   s.input_text = cfg.source_text;
   s.input_path = cfg.source_path;
-  s.reason = reason;
-  s.step = run.step;
-  s.time = run.time;
-  s.dt = run.dt;
-  s.good_since_cut = run.good_since_cut;
-  s.failed_steps = run.failed_steps;
-  s.newton_iterations = run.newton_iterations;
-  s.next_vtu = run.next_vtu;
-  s.next_csv = run.next_csv;
-  s.csv_rows = run.csv_rows;
-  s.vtu_times = run.vtu_times;
-  const auto& p = model.points;
-  s.x = flatten<Dim>(p.x);
-  s.v = flatten<Dim>(p.v);
-  s.L = flatten<Dim>(p.L);
-  s.F = flatten<Dim>(p.F);
-  s.sigma = flatten<Dim>(p.sigma);
-  s.domain = flatten<Dim>(p.domain);
-  s.sigma_zz = p.sigma_zz;
-  s.mass = p.mass;
-  s.volume0 = p.volume0;
-  s.volume = p.volume;
-  s.grain = p.grain;
-  s.history = p.history;
-  for (const auto& g : model.grains) {
-    s.grain_begin.push_back(g.begin);
-    s.grain_end.push_back(g.end);
-    s.grain_material.push_back(g.material);
-    s.grain_half_width.push_back(g.half_width);
-    s.grain_history_offset.push_back(g.history_offset);
-  }
-  for (const auto& w : run.warm) {
+  for_each_point_field<Dim>([&](auto field, auto array) { put(model.points.*field, s.*array); });
+  for_each_grain_field([&](auto field, auto array) {
+    auto& out = s.*array;
+    out.clear();
+    for (const auto& g : model.grains) out.push_back(g.*field);
+  });
+  s.warm_node.clear();
+  s.warm_a.clear();
+  s.warm_b.clear();
+  s.warm_impulse.clear();
+  for (const auto& w : warm) {
     s.warm_node.push_back(w.node);
     s.warm_a.push_back(w.a);
     s.warm_b.push_back(w.b);
     for (int a = 0; a < Dim; ++a) s.warm_impulse.push_back(w.impulse[a]);
   }
-  for (const auto& x : run.wall_points)
+  s.wall_point.clear();
+  for (const auto& w : walls) {
+    const Vec<Dim> x = w.point + s.time * w.velocity;
     for (int a = 0; a < Dim; ++a) s.wall_point.push_back(x[a]);
-  s.ranks = run.ranks;
-  s.scheme = run.scheme;
-  s.threads = run.threads;
-  s.grain_owner.assign(run.grain_owner.begin(), run.grain_owner.end());
-  s.grain_work = run.grain_work;
-  s.wall_work = run.energy.wall_work;
-  s.energy0 = run.energy.energy0;
-  s.kinetic0 = run.energy.kinetic0;
-  s.contact_dissipation = run.energy.contact_dissipation;
-  s.transfer_dissipation = run.energy.transfer_dissipation;
-  s.stress_work = run.energy.stress_work;
-  s.body_work = run.energy.body_work;
-  return s;
+  }
 }
 
 template <int Dim>
-RunState<Dim> run_state_of(const checkpoint::State& s) {
-  RunState<Dim> run;
-  run.step = s.step;
-  run.time = s.time;
-  run.dt = s.dt;
-  run.good_since_cut = s.good_since_cut;
-  run.failed_steps = s.failed_steps;
-  run.newton_iterations = s.newton_iterations;
-  run.next_vtu = s.next_vtu;
-  run.next_csv = s.next_csv;
-  run.csv_rows = s.csv_rows;
-  run.vtu_times = s.vtu_times;
-  run.warm.resize(s.warm_node.size());
-  for (std::size_t k = 0; k < run.warm.size(); ++k)
-    run.warm[k] = {s.warm_node[k], s.warm_a[k], s.warm_b[k], vec_at<Dim>(s.warm_impulse, k)};
-  run.wall_points = vectors<Dim>(s.wall_point, s.wall_point.size() / Dim);
-  run.energy.wall_work = s.wall_work;
-  run.energy.energy0 = s.energy0;
-  run.energy.kinetic0 = s.kinetic0;
-  run.energy.contact_dissipation = s.contact_dissipation;
-  run.energy.transfer_dissipation = s.transfer_dissipation;
-  run.energy.stress_work = s.stress_work;
-  run.energy.body_work = s.body_work;
-  run.ranks = s.ranks;
-  run.scheme = s.scheme;
-  run.threads = s.threads;
-  run.grain_owner.assign(s.grain_owner.begin(), s.grain_owner.end());
-  run.grain_work = s.grain_work;
-  return run;
+std::vector<mpm::WarmImpulse<Dim>> warm_start_of(const checkpoint::State& s) {
+  std::vector<mpm::WarmImpulse<Dim>> warm(s.warm_node.size());
+  for (std::size_t k = 0; k < warm.size(); ++k)
+    warm[k] = {s.warm_node[k], s.warm_a[k], s.warm_b[k], vec_at<Dim>(s.warm_impulse, k)};
+  return warm;
+}
+
+void store_energy(const EnergySums& e, checkpoint::State& s) {
+  for_each_energy_field([&](auto sum, auto field) { s.*field = e.*sum; });
+}
+
+EnergySums energy_sums_of(const checkpoint::State& s) {
+  EnergySums e;
+  for_each_energy_field([&](auto sum, auto field) { e.*sum = s.*field; });
+  return e;
 }
 
 template <int Dim>
@@ -157,25 +166,10 @@ mpm::Model<Dim> restore_model(const io::Config& cfg, const checkpoint::State& s,
   mpm::Model<Dim> model = model_frame<Dim>(cfg);
   const std::size_t n = s.points();
   auto& p = model.points;
-  p.x = vectors<Dim>(s.x, n);
-  p.v = vectors<Dim>(s.v, n);
-  p.L = matrices<Dim>(s.L, n);
-  p.F = matrices<Dim>(s.F, n);
-  p.sigma = matrices<Dim>(s.sigma, n);
-  p.domain = matrices<Dim>(s.domain, n);
-  p.sigma_zz = s.sigma_zz;
-  p.mass = s.mass;
-  p.volume0 = s.volume0;
-  p.volume = s.volume;
-  p.grain = s.grain;
-  p.history = s.history;
+  for_each_point_field<Dim>([&](auto field, auto array) { take(s.*array, p.*field, n); });
   for (std::size_t g = 0; g < s.grain_begin.size(); ++g) {
     points::Grain gr;
-    gr.begin = s.grain_begin[g];
-    gr.end = s.grain_end[g];
-    gr.material = s.grain_material[g];
-    gr.half_width = s.grain_half_width[g];
-    gr.history_offset = s.grain_history_offset[g];
+    for_each_grain_field([&](auto field, auto array) { gr.*field = (s.*array)[g]; });
     if (gr.material >= static_cast<int>(model.laws.size()))
       throw refuse(fmt::format("grain {} has material {}, the input has {} materials", g,
                                gr.material, model.laws.size()));
@@ -200,11 +194,12 @@ mpm::Model<Dim> restore_model(const io::Config& cfg, const checkpoint::State& s,
   return model;
 }
 
-template checkpoint::State to_checkpoint<2>(const io::Config&, const mpm::Model<2>&,
-                                            const RunState<2>&, const std::string&);
-template RunState<2> run_state_of<2>(const checkpoint::State&);
+template void store_run<2>(const io::Config&, const mpm::Model<2>&,
+                           const std::vector<mpm::WarmImpulse<2>>&,
+                           const std::vector<mpm::Wall<2>>&, checkpoint::State&);
 template mpm::Model<2> restore_model<2>(const io::Config&, const checkpoint::State&,
                                         const std::string&);
+template std::vector<mpm::WarmImpulse<2>> warm_start_of<2>(const checkpoint::State&);
 
 Restart load_restart(const std::string& path, const std::string& input) {
   Restart r;
@@ -228,9 +223,9 @@ RestoredRun restore_from_checkpoint(const std::string& path, const std::string& 
   Restart r = load_restart(path, input);
   mpm::Model<2> model = restore_model<2>(r.config, r.state, path);
   mpm::Settings<2> settings = build_settings(r.config);
-  RunState<2> run = run_state_of<2>(r.state);
-  return RestoredRun{std::move(r.config), std::move(model), std::move(settings), std::move(run),
-                     path};
+  std::vector<mpm::WarmImpulse<2>> warm = warm_start_of<2>(r.state);
+  return RestoredRun{std::move(r.config), std::move(r.state), std::move(model),
+                     std::move(settings), std::move(warm),    path};
 }
 
 }  // namespace mpmcd::app

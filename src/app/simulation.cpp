@@ -61,12 +61,12 @@ mpm::Settings<2> checked_settings(const io::Config& cfg, const mpm::Model<2>& mo
   return settings;
 }
 
-// Where a new run starts: t = 0 at the nominal step, the energy ledger at the model's energy.
-RunState<2> start_state(const io::Config& cfg, const mpm::Model<2>& model) {
-  RunState<2> s;
-  s.dt = cfg.time.dt;
-  s.energy = EnergyLedger<2>::start(cfg.walls.size(), mpm::diagnostics(model));
-  return s;
+// The energy ledger's sums where the run starts: the checkpoint's, or none at the model's energy
+// at t = 0 (every rank holds the initial points).
+EnergySums start_energy(const io::Config& cfg, const mpm::Model<2>& model,
+                        const checkpoint::State* restart) {
+  return restart ? energy_sums_of(*restart)
+                 : EnergyLedger<2>::start(cfg.walls.size(), mpm::diagnostics(model));
 }
 
 }  // namespace
@@ -95,21 +95,20 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
       model_(initial_model(cfg, opt, restart)),
       settings_(checked_settings(cfg, model_, restart != nullptr)),
       observer_(cfg, model_),
-      start_(restart ? run_state_of<2>(*restart) : start_state(cfg, model_)),
       comm_(parallel::Comm::world()),
       root_(comm_.rank() == 0),
       scheme_(parallel::scheme_from_string(opt.scheme.empty() ? "partition" : opt.scheme)),
       any_moving_(std::any_of(cfg.boundaries.begin(), cfg.boundaries.end(),
                               [](const auto& b) { return b.moving; })),
       stop_active_(cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0),
-      ledger_(start_.energy),
+      ledger_(start_energy(cfg, model_, restart)),
       dt_control_(cfg.time),
       progress_(cfg.time.end_time, cfg.stop, observer_.initial_phi()),
-      t_(start_.time),
-      next_vtu_(start_.next_vtu),
-      next_csv_(start_.next_csv),
-      steps0_(start_.step),
-      last_checkpoint_step_(restart ? start_.step : -1) {
+      t_(restart ? restart->time : 0.0),
+      next_vtu_(restart ? restart->next_vtu : 0.0),
+      next_csv_(restart ? restart->next_csv : 0.0),
+      steps0_(restart ? restart->step : 0),
+      last_checkpoint_step_(restart ? restart->step : -1) {
   summary_.output_dir = output_folder(cfg, opt, restart != nullptr);
   if (!root_) log().set_level(spdlog::level::off);  // rank 0 reports
   // A restart written elsewhere than its checkpoint: the checkpoint's folder, its history.
@@ -129,13 +128,13 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
       "threads",
       kVersion, kGitHash, model_.grains.size(), model_.points.size(), model_.grid.cells()[0],
       model_.grid.cells()[1], model_.grid.cell_size(), comm_.size(), omp_get_max_threads());
-  summary_.steps = start_.step;
-  summary_.failed_steps = start_.failed_steps;
-  summary_.newton_iterations = start_.newton_iterations;
   if (restart) {
-    dt_control_.restore(start_.dt, start_.good_since_cut);
+    dt_control_.restore(restart->dt, restart->good_since_cut);
+    summary_.steps = restart->step;
+    summary_.failed_steps = restart->failed_steps;
+    summary_.newton_iterations = restart->newton_iterations;
     // Every rank gets every impulse; a rank looks up only the contacts it solves.
-    solver_->set_warm_start(std::move(start_.warm));
+    solver_->set_warm_start(warm_start_of<2>(*restart));
     if (root_) out_->restore_contacts(*solver_);
     log().info("restarted from {} (written by mpmcd {} on {} rank(s)): step {}, t = {:.9g} s",
                opt.restart, restart->mpmcd_version, restart->ranks, summary_.steps, t_);
@@ -156,18 +155,18 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
 // distribution and re-balancing counts (bitwise continuation); otherwise the grains are dealt
 // again from the restored state.
 void Run::distribute() {
-  const bool keep =
-      restart_ && start_.ranks == comm_.size() && start_.scheme == parallel::to_string(scheme_);
+  const bool keep = restart_ && restart_->ranks == comm_.size() &&
+                    restart_->scheme == parallel::to_string(scheme_);
   if (comm_.size() > 1) {
     std::vector<int> owner =
-        keep ? start_.grain_owner
+        keep ? std::vector<int>(restart_->grain_owner.begin(), restart_->grain_owner.end())
              : parallel::deal_grains(model_.points, model_.grains, scheme_, comm_.size());
     solver_->set_distribution(&comm_, owner, scheme_);
   }
   if (keep) {
-    std::vector<double> work(start_.grain_work);
-    for (std::size_t g = 0; g < start_.grain_owner.size(); ++g)
-      if (start_.grain_owner[g] != comm_.rank())
+    std::vector<double> work(restart_->grain_work);
+    for (std::size_t g = 0; g < restart_->grain_owner.size(); ++g)
+      if (restart_->grain_owner[g] != comm_.rank())
         std::fill_n(work.begin() + static_cast<std::ptrdiff_t>(g * parallel::kWorkPhases),
                     parallel::kWorkPhases, 0.0);
     solver_->set_grain_work(std::move(work));

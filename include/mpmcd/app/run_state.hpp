@@ -1,9 +1,9 @@
 #pragma once
-/// The state of a run after a committed step, and its conversion to and from a checkpoint
-/// (checkpoint::State, plain arrays; docs/robustness.md): the model's points and grains, the time
-/// stepping and output counters, the contact warm start, the walls, the energy ledger and the
-/// distribution over ranks. Written once for any dimension; a restart, or a benchmark that starts
-/// from a checkpoint file (restore_from_checkpoint), restores a run through it.
+/// The state of a run after a committed step to and from a checkpoint (checkpoint::State, plain
+/// arrays; docs/robustness.md): the model's points and grains, the contact warm start, the walls
+/// and the energy ledger's sums (the counters are the State's own fields). Written once for any
+/// dimension; a restart, or a benchmark that starts from a checkpoint file
+/// (restore_from_checkpoint), restores a run through it.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -16,44 +16,14 @@
 
 namespace mpmcd::app {
 
-/// Where a run stands after a committed step, besides its points and grains (the model): what a
-/// checkpoint holds with the model.
+/// Fills `state` with the input `config` of the run, the points and grains of `model`, the
+/// contact warm start `warm` and the points of `walls` at state.time. The run's counters (time
+/// stepping, outputs, energy ledger: store_energy, distribution) are checkpoint::State's own
+/// fields, set by the caller.
 template <int Dim>
-struct RunState {
-  // Time stepping.
-  std::int64_t step = 0;               ///< committed steps [-]
-  double time = 0;                     ///< simulated time t^n [s]
-  double dt = 0;                       ///< current (possibly cut) time step [s]
-  std::int64_t good_since_cut = 0;     ///< good steps since the last dt cut [-]
-  std::int64_t failed_steps = 0;       ///< attempts retried with a smaller dt so far [-]
-  std::int64_t newton_iterations = 0;  ///< Newton iterations so far [-]
-  // Output counters.
-  double next_vtu = 0;            ///< simulated time of the next VTU snapshot [s]
-  double next_csv = 0;            ///< simulated time of the next CSV row [s]
-  std::int64_t csv_rows = 0;      ///< CSV rows written so far (header excluded) [-]
-  std::vector<double> vtu_times;  ///< time of each VTU snapshot written so far [s]
-  // Contact and walls.
-  std::vector<mpm::WarmImpulse<Dim>> warm;  ///< impulses of the last step (warm start) [N s]
-  std::vector<Vec<Dim>> wall_points;        ///< current point of each wall plane [m]
-  EnergySums energy;                        ///< the energy ledger's sums since t = 0 [J]
-  // Distribution (docs/parallel.md).
-  int ranks = 1;                     ///< MPI ranks of the run [-]
-  std::string scheme = "partition";  ///< parallel scheme of the run [-]
-  int threads = 1;                   ///< OpenMP threads per rank [-]
-  std::vector<int> grain_owner;      ///< rank owning each grain [-]
-  /// Re-balancing work since the last check, grain x parallel::kWorkPhases (grain-major) [-].
-  std::vector<double> grain_work;
-};
-
-/// The checkpoint of the run of input `config` whose model is `model` and state `run`, written
-/// for `reason` ("periodic", "end", "signal", "stop_after", "failure") [-].
-template <int Dim>
-checkpoint::State to_checkpoint(const io::Config& config, const mpm::Model<Dim>& model,
-                                const RunState<Dim>& run, const std::string& reason);
-
-/// The run state held by `state` (points and grains excluded: restore_model).
-template <int Dim>
-RunState<Dim> run_state_of(const checkpoint::State& state);
+void store_run(const io::Config& config, const mpm::Model<Dim>& model,
+               const std::vector<mpm::WarmImpulse<Dim>>& warm,
+               const std::vector<mpm::Wall<Dim>>& walls, checkpoint::State& state);
 
 /// The model of a restart: grid and materials from `config`, points and grains from `state` (no
 /// packing is regenerated). Throws InputError naming `path` if they do not fit together
@@ -62,11 +32,21 @@ template <int Dim>
 mpm::Model<Dim> restore_model(const io::Config& config, const checkpoint::State& state,
                               const std::string& path);
 
-extern template checkpoint::State to_checkpoint<2>(const io::Config&, const mpm::Model<2>&,
-                                                   const RunState<2>&, const std::string&);
-extern template RunState<2> run_state_of<2>(const checkpoint::State&);
+/// The contact warm start held by `state` (impulses of the last converged step).
+template <int Dim>
+std::vector<mpm::WarmImpulse<Dim>> warm_start_of(const checkpoint::State& state);
+
+/// Stores the energy ledger's sums in `state`.
+void store_energy(const EnergySums& sums, checkpoint::State& state);
+/// The energy ledger's sums held by `state`.
+EnergySums energy_sums_of(const checkpoint::State& state);
+
+extern template void store_run<2>(const io::Config&, const mpm::Model<2>&,
+                                  const std::vector<mpm::WarmImpulse<2>>&,
+                                  const std::vector<mpm::Wall<2>>&, checkpoint::State&);
 extern template mpm::Model<2> restore_model<2>(const io::Config&, const checkpoint::State&,
                                                const std::string&);
+extern template std::vector<mpm::WarmImpulse<2>> warm_start_of<2>(const checkpoint::State&);
 
 /// A checkpoint and the input of the run it continues.
 struct Restart {
@@ -80,14 +60,15 @@ struct Restart {
 /// text stored in the checkpoint. Throws InputError (exit 2).
 Restart load_restart(const std::string& path, const std::string& input);
 
-/// A 2D run restored from a checkpoint file, ready to step on (solver built from `model` and
-/// `settings`, boundaries at run.time, warm start run.warm).
+/// A 2D run restored from a checkpoint file, ready to step on (a solver built from `model` and
+/// `settings`, boundaries at state.time, warm start `warm`).
 struct RestoredRun {
   io::Config config;          ///< the input of the run
+  checkpoint::State state;    ///< the checkpoint: time, dt, counters, ledger, distribution
   mpm::Model<2> model;        ///< grid, materials, points and grains at the checkpoint
   mpm::Settings<2> settings;  ///< solver settings from the input
-  RunState<2> run;            ///< time, dt, counters, warm start, ledger at the checkpoint
-  std::string path;           ///< the checkpoint file
+  std::vector<mpm::WarmImpulse<2>> warm;  ///< contact impulses of the last step (warm start)
+  std::string path;                       ///< the checkpoint file
 };
 
 /// Restores the run of checkpoint `path` with its input (`input`, or the text the checkpoint
