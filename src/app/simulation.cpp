@@ -61,8 +61,8 @@ mpm::Settings<2> checked_settings(const io::Config& cfg, const mpm::Model<2>& mo
   return settings;
 }
 
-// The energy ledger's sums where the run starts: the checkpoint's, or none at the model's energy
-// at t = 0 (every rank holds the initial points).
+// The energy ledger's sums where the run starts: the checkpoint's, or zero sums from the model's
+// energy at t = 0 (every rank holds the initial points).
 EnergySums start_energy(const io::Config& cfg, const mpm::Model<2>& model,
                         const checkpoint::State* restart) {
   return restart ? energy_sums_of(*restart)
