@@ -7,6 +7,8 @@
 #include <iostream>
 
 #include "mpmcd/app/analyze.hpp"
+#include "mpmcd/app/model_builder.hpp"
+#include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/simulation.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"

@@ -4,33 +4,28 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <chrono>
-#include <cmath>
 #include <csignal>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <map>
-#include <numbers>
-#include <regex>
+#include <memory>
+#include <optional>
+#include <utility>
 
 #include "mpmcd/app/compaction_observer.hpp"
+#include "mpmcd/app/energy_ledger.hpp"
+#include "mpmcd/app/model_builder.hpp"
+#include "mpmcd/app/outputs.hpp"
 #include "mpmcd/app/progress.hpp"
+#include "mpmcd/app/run_folder.hpp"
+#include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/speed_check.hpp"
+#include "mpmcd/app/step_controller.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
-#include "mpmcd/io/load_config.hpp"
-#include "mpmcd/io/output_folder.hpp"
 #include "mpmcd/io/vtu.hpp"
-#include "mpmcd/packing/input.hpp"
-#include "mpmcd/packing/overlap.hpp"
-#include "mpmcd/packing/packing.hpp"
-#include "mpmcd/packing/seeding.hpp"
 #include "mpmcd/parallel/distribute.hpp"
-#include "mpmcd/points/seeding.hpp"
 #include "mpmcd/version.hpp"
+#include "run.hpp"
 
 namespace mpmcd::app {
 
@@ -38,885 +33,111 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Vec<2> vec2(const std::vector<double>& v) {
-  return Vec<2>(v.at(0), v.at(1));
-}
-
-// v(x) = velocity + gradient (x - c) + omega e_z x (x - c) + A sin(k . x + phase) (InitialVelocity)
-Vec<2> initial_velocity(const io::InitialVelocity& iv, const Vec<2>& c, const Vec<2>& x) {
-  Vec<2> v = Vec<2>::Zero();
-  if (iv.velocity.size() == 2) v += vec2(iv.velocity);
-  if (iv.gradient.size() == 4) {
-    Mat<2> L;
-    L << iv.gradient[0], iv.gradient[1], iv.gradient[2], iv.gradient[3];
-    v += L * (x - c);
-  }
-  const Vec<2> r = x - c;
-  v += iv.angular_velocity * Vec<2>(-r[1], r[0]);
-  if (iv.sine_amplitude.size() == 2 && iv.sine_wavevector.size() == 2)
-    v += vec2(iv.sine_amplitude) * std::sin(vec2(iv.sine_wavevector).dot(x) + iv.sine_phase);
-  return v;
-}
-
-// Every disk of a packing file becomes a grain (points from packing::seed_packing, which gives a
-// lattice site shared by two overlapping disks to one of them only).
-// Grain outlines for the overlap check, and what each one is (grain index, packing disk id or -1).
-struct Outlines {
-  std::vector<packing::Outline> shapes;
-  std::vector<std::pair<std::size_t, std::int64_t>> owner;
-};
-
-// Refuses a packing input whose box cannot fit inside the grid (one cell of margin) before the
-// DEM runs (issue 17: 20,000 disks took 18 s to be refused). The box is known when given; else
-// its smallest possible size follows from the smallest disks at the target packing fraction
-// (grow, walls) or at Phi = 1 (jam, whose final Phi is found by the run).
-void check_packing_box(const packing::PackingParams& p, const grid::Grid<2>& grid,
-                       const io::Config& cfg, std::size_t index) {
-  const auto& g = cfg.grains[index];
-  const double h = grid.cell_size();
-  const Vec<2> lo = grid.origin().array() + h, hi = grid.upper().array() - h;
-  Vec<2> b0, b1;
-  if (p.box) {
-    b0 = Vec<2>((*p.box)[0], (*p.box)[1]);
-    b1 = Vec<2>((*p.box)[2], (*p.box)[3]);
-  } else {
-    double area = 0;  // smallest possible disk area [m^2]
-    if (!p.diameters.empty())
-      for (const double d : p.diameters) area += std::numbers::pi * 0.25 * d * d;
-    else
-      area =
-          static_cast<double>(p.count) * std::numbers::pi * 0.25 * p.diameter_min * p.diameter_min;
-    const double phi = p.method == packing::PackingMethod::kJam ? 1.0 : p.target_phi;
-    b0 = Vec<2>(p.origin[0], p.origin[1]);
-    b1 =
-        b0 + Vec<2>(std::sqrt(area / phi * p.aspect_ratio), std::sqrt(area / phi / p.aspect_ratio));
-  }
-  if ((b0.array() < lo.array()).any() || (b1.array() > hi.array()).any())
-    throw InputError(g.file, 0, "packing",
-                     fmt::format("the packing box [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] m{} must lie "
-                                 "inside the grid with one cell of margin, [{:.6g}, {:.6g}] x "
-                                 "[{:.6g}, {:.6g}] m (grains[{}], {}:{}); checked before the DEM "
-                                 "runs",
-                                 b0[0], b1[0], b0[1], b1[1], p.box ? "" : " (at least)", lo[0],
-                                 hi[0], lo[1], hi[1], index, cfg.source_path, g.line));
-}
-
-void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t index,
-                        int material, Outlines& outlines) {
-  const auto& g = cfg.grains[index];
-  packing::Packing pk;
-  if (fs::path(g.file).extension() == ".toml") {  // a packing input: generate it now (seeded DEM)
-    const auto input = packing::load_packing_input(g.file);
-    check_packing_box(input.params, model.grid, cfg, index);
-    pk = packing::generate_packing(input.params);
-    log().info("generated from {}: {}", g.file, packing::summary_line(pk));
-  } else {
-    pk = packing::read_packing_csv(g.file);
-  }
-  const double h = model.grid.cell_size();
-  const Vec<2> lo = model.grid.origin().array() + h, hi = model.grid.upper().array() - h;
-  for (const auto& d : pk.disks) {
-    const Vec<2> c(d.x, d.y);
-    if (((c.array() - d.radius) < lo.array()).any() || ((c.array() + d.radius) > hi.array()).any())
-      throw InputError(g.file, 0, fmt::format("disk {}", d.id),
-                       fmt::format("the disk (center {:.6g} {:.6g} m, radius {:.6g} m) must lie "
-                                   "inside the grid with one cell of margin (grains[{}], {}:{})",
-                                   d.x, d.y, d.radius, index, cfg.source_path, g.line));
-    outlines.shapes.push_back({d.x, d.y, 0.0, 0.0, d.radius});
-    outlines.owner.emplace_back(index, d.id);
-  }
-  if (g.seeding == "polar") {  // each disk on its own rings, strictly inside its circle
-    const double s = h / g.points_per_cell;
-    double estimate = 0;
-    for (const auto& d : pk.disks) estimate += std::numbers::pi * d.radius * d.radius / (s * s);
-    if (estimate > 2e8)
-      throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].points_per_cell", index),
-                       fmt::format("the packing would need about {:.3g} material points (at most "
-                                   "2e8): coarsen the grid or lower points_per_cell",
-                                   estimate));
-    for (const auto& d : pk.disks) {
-      const Vec<2> c(d.x, d.y);
-      model.add_grain(points::seed_disk_polar(c, d.radius, h / g.points_per_cell), material,
-                      0.5 * h / g.points_per_cell,
-                      [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
-    }
-    return;
-  }
-  const auto seeded = packing::seed_packing(pk, model.grid.origin(), h, g.points_per_cell);
-  for (std::size_t k = 0; k < pk.disks.size(); ++k) {
-    points::Seeds<2> seeds;
-    seeds.x.assign(seeded.x.begin() + seeded.offset[k], seeded.x.begin() + seeded.offset[k + 1]);
-    seeds.volume.assign(seeded.volume.begin() + seeded.offset[k],
-                        seeded.volume.begin() + seeded.offset[k + 1]);
-    const Vec<2> c(pk.disks[k].x, pk.disks[k].y);
-    model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
-                    [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
-  }
-}
-
-}  // namespace
-
-namespace {
-
-// The grid and the materials of the input, no grains yet.
-mpm::Model<2> model_frame(const io::Config& cfg) {
-  mpm::Model<2> model;
-  const double h = cfg.grid.cell_size;
-  IVec<2> cells;
-  for (int d = 0; d < 2; ++d)
-    cells[d] = static_cast<std::int64_t>(std::llround(cfg.grid.extent[d] / h));
-  model.grid = grid::Grid<2>(vec2(cfg.grid.origin), h, cells);
-  for (const auto& m : cfg.materials) {
-    try {
-      model.add_material(materials::make_law<2>(m.law, m.params), m.density);
-    } catch (const InputError& e) {
-      throw InputError(cfg.source_path, m.line, "materials." + e.key(), e.what());
-    }
-  }
-  return model;
-}
-
-}  // namespace
-
-// Grains may touch but not overlap (docs/robustness.md): their common area would be counted twice
-// in the volume and Phi. Names both grains (a packing's disk by its id) and the overlap.
-void check_no_overlap(const io::Config& cfg, const Outlines& outlines) {
-  const auto o = packing::find_overlap(outlines.shapes, packing::kOverlapTolerance);
-  if (!o) return;
-  const auto describe = [&](std::size_t k) {
-    const auto [i, id] = outlines.owner[k];
-    const auto& g = cfg.grains[i];
-    return id >= 0 ? fmt::format("disk id {} of {} (grains[{}], line {})", id, g.file, i, g.line)
-                   : fmt::format("grains[{}] (line {})", i, g.line);
-  };
-  const std::size_t later = outlines.owner[o->second].first;
-  throw InputError(
-      cfg.source_path, cfg.grains[later].line, fmt::format("grains[{}]", later),
-      fmt::format("grains that touch but do not overlap (up to {:g} of the smaller one's "
-                  "diameter or side): {} overlaps {} by {:.6g} m = {:.3g} of the smaller size "
-                  "(their common area would be counted twice in the volume and Phi)",
-                  packing::kOverlapTolerance, describe(o->second), describe(o->first), o->depth,
-                  o->depth / o->size));
-}
-
-mpm::Model<2> build_model(const io::Config& cfg) {
-  mpm::Model<2> model = model_frame(cfg);
-  const double h = cfg.grid.cell_size;
-  Outlines outlines;
-  for (std::size_t i = 0; i < cfg.grains.size(); ++i) {
-    const auto& g = cfg.grains[i];
-    int material = -1;
-    for (std::size_t k = 0; k < cfg.materials.size(); ++k)
-      if (cfg.materials[k].name == g.material) material = static_cast<int>(k);
-    points::Seeds<2> seeds;
-    Vec<2> center;
-    if (g.shape == "disk") {
-      center = vec2(g.center);
-      outlines.shapes.push_back({center[0], center[1], 0.0, 0.0, g.radius});
-      seeds =
-          g.seeding == "polar"
-              ? points::seed_disk_polar(center, g.radius, h / g.points_per_cell)
-              : points::seed_ball<2>(model.grid.origin(), h, g.points_per_cell, center, g.radius);
-    } else if (g.shape == "rectangle") {
-      const Vec<2> lo = vec2(g.min_corner), hi = vec2(g.max_corner);
-      center = 0.5 * (lo + hi);
-      outlines.shapes.push_back({lo[0], lo[1], hi[0], hi[1], 0.0});
-      seeds = points::seed_box<2>(model.grid.origin(), h, g.points_per_cell, lo, hi);
-    } else if (g.shape == "packing") {
-      add_packing_grains(model, cfg, i, material, outlines);
-      continue;
-    } else {
-      throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].shape", i),
-                       "unknown shape \"" + g.shape + "\"");
-    }
-    outlines.owner.emplace_back(i, -1);
-    if (seeds.x.empty())
-      throw InputError(cfg.source_path, g.line, fmt::format("grains[{}]", i),
-                       "the grain is too small to hold a material point at this cell size and "
-                       "points_per_cell: refine the grid or raise points_per_cell");
-    model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
-                    [&](const Vec<2>& x) { return initial_velocity(g.initial, center, x); });
-  }
-  check_no_overlap(cfg, outlines);
-  return model;
-}
-
-std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& cfg, const grid::Grid<2>& grid,
-                                                 double t) {
-  std::vector<mpm::VelocityBC<2>> out;
-  const auto& n = grid.nodes_per_axis();
-  const double h = grid.cell_size();
-  for (const auto& b : cfg.boundaries) {
-    mpm::VelocityBC<2> bc;
-    for (const auto& f : b.fix) bc.mask |= static_cast<std::uint8_t>(1u << (f == "x" ? 0 : 1));
-    bc.velocity = vec2(b.velocity);
-    IVec<2> lo = IVec<2>::Zero(), hi = n - IVec<2>::Ones();
-    if (b.nodes == "xmin") hi[0] = 0;
-    if (b.nodes == "xmax") lo[0] = n[0] - 1;
-    if (b.nodes == "ymin") hi[1] = 0;
-    if (b.nodes == "ymax") lo[1] = n[1] - 1;
-    if (b.nodes == "box") {
-      const Vec<2> shift = b.moving ? Vec<2>(t * bc.velocity) : Vec<2>::Zero();
-      for (int d = 0; d < 2; ++d) {
-        const double a = (b.box_min[d] + shift[d] - grid.origin()[d]) / h;
-        const double z = (b.box_max[d] + shift[d] - grid.origin()[d]) / h;
-        lo[d] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a - 1e-9)));
-        hi[d] = std::min<std::int64_t>(n[d] - 1, static_cast<std::int64_t>(std::floor(z + 1e-9)));
-      }
-    }
-    for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
-      for (std::int64_t i = lo[0]; i <= hi[0]; ++i) bc.nodes.push_back(grid.node_index({i, j}));
-    out.push_back(std::move(bc));
-  }
-  return out;
-}
-
-mpm::Settings<2> build_settings(const io::Config& cfg) {
-  mpm::Settings<2> s;
-  s.shape = grid::shape_kind_from_string(cfg.grid.shape_function);
-  s.theta = cfg.time.theta;
-  s.max_iterations = cfg.solver.max_iterations;
-  s.residual_tolerance = cfg.solver.residual_tolerance;
-  s.increment_tolerance = cfg.solver.increment_tolerance;
-  s.linear_solver = mpm::linear_solver_from_string(cfg.solver.linear_solver);
-  s.cg_tolerance = cfg.solver.cg_tolerance;
-  s.cg_max_iterations = cfg.solver.cg_max_iterations;
-  s.flip = cfg.solver.flip;
-  s.affine = cfg.solver.affine;
-  s.modified_newton = cfg.solver.modified_newton;
-  if (cfg.loads.gravity.size() == 2) s.gravity = vec2(cfg.loads.gravity);
-  // Contact: enabled when asked and there is something to touch (two grains or a wall).
-  auto& c = s.contact;
-  std::size_t grains = 0;
-  for (const auto& g : cfg.grains) grains += g.shape == "packing" ? 2 : 1;
-  c.enabled = cfg.contact.enabled && (grains > 1 || !cfg.walls.empty());
-  c.criterion =
-      cfg.contact.criterion == "overlap" ? mpm::GapCriterion::kOverlap : mpm::GapCriterion::kGap;
-  c.mass_fraction = cfg.contact.mass_fraction;
-  c.gs.tolerance = cfg.contact.tolerance;
-  c.gs.max_sweeps = cfg.contact.max_sweeps;
-  c.gs.relaxation = cfg.contact.relaxation;
-  c.gs.relax_after = cfg.contact.relax_after;
-  c.gs.node_blocks = cfg.contact.node_blocks;
-  c.impulse_tolerance = cfg.contact.impulse_tolerance;
-  c.wall_range = cfg.contact.wall_range;
-  c.wall_points = cfg.contact.wall_contact == "points";
-  // Delassus operator: the lumped 1/m_I is accurate when inertia dominates a step (theta c_p dt/h
-  // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered
-  // contact-Newton loop converging in a few iterations.
-  double cp = 0;
-  for (const auto& m : cfg.materials)
-    cp = std::max(cp, std::sqrt((m.params.at("lambda") + 2 * m.params.at("mu")) / m.density));
-  const double courant = cfg.time.theta * cp * cfg.time.dt / cfg.grid.cell_size;
-  c.grain_compliance =
-      cfg.contact.delassus == "grain" || (cfg.contact.delassus == "auto" && courant > 0.1);
-  const auto nm = static_cast<int>(cfg.materials.size());
-  c.materials = nm;
-  c.friction.assign(static_cast<std::size_t>(nm * nm), cfg.contact.friction);
-  auto index = [&](const std::string& name) {
-    for (int k = 0; k < nm; ++k)
-      if (cfg.materials[k].name == name) return k;
-    return 0;
-  };
-  for (const auto& p : cfg.contact.pairs) {
-    const int a = index(p.materials[0]), b = index(p.materials[1]);
-    c.friction[a * nm + b] = c.friction[b * nm + a] = p.friction;
-  }
-  for (const auto& w : cfg.walls)
-    c.walls.push_back({w.name, vec2(w.point), vec2(w.normal), vec2(w.velocity), w.friction});
-  return s;
-}
-
-void check_walls_enclose(const io::Config& cfg, const mpm::Model<2>& model,
-                         const mpm::Settings<2>& settings) {
-  for (std::size_t k = 0; k < settings.contact.walls.size(); ++k) {
-    const auto& wall = settings.contact.walls[k];
-    for (std::size_t p = 0; p < model.points.size(); ++p)
-      if (wall.distance(model.points.x[p], 0.0) < 0.0)
-        throw InputError(cfg.source_path, cfg.walls[k].line, fmt::format("walls[{}]", k),
-                         fmt::format("wall \"{}\" does not enclose the grains: grain {} has a "
-                                     "material point at ({:.6g}, {:.6g}) m on its outer side",
-                                     wall.name, model.points.grain[p], model.points.x[p][0],
-                                     model.points.x[p][1]));
-  }
-}
-
-namespace {
-
-// Writes one VTU snapshot of the points.
-void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {
-  const auto& p = model.points;
-  io::VtuPointCloud vtu(p.size());
-  auto& vel = vtu.add_array("velocity", 3);
-  auto& sig = vtu.add_array("stress", 9);
-  auto& pres = vtu.add_array("pressure", 1);
-  auto& jac = vtu.add_array("J", 1);
-  auto& mass = vtu.add_array("mass", 1);
-  auto& vol = vtu.add_array("volume", 1);
-  auto& grain = vtu.add_int_array("grain");
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    vtu.set_position(i, p.x[i][0], p.x[i][1]);
-    vel[3 * i] = p.v[i][0];
-    vel[3 * i + 1] = p.v[i][1];
-    const Mat<2>& s = p.sigma[i];
-    const double s3[9] = {s(0, 0), s(0, 1), 0, s(1, 0), s(1, 1), 0, 0, 0, p.sigma_zz[i]};
-    for (int k = 0; k < 9; ++k) sig[9 * i + k] = s3[k];
-    pres[i] = -(s(0, 0) + s(1, 1) + p.sigma_zz[i]) / 3.0;  // p = -tr(sigma)/3 (plane strain)
-    jac[i] = p.F[i].determinant();
-    mass[i] = p.mass[i];
-    vol[i] = p.volume[i];
-    grain[i] = p.grain[i];
-  }
-  vtu.write(path);
-}
-
-// Keeps the header and the first `rows` complete rows of the CSV at `path` (drops the rows
-// written after a checkpoint and a torn last line); returns the rows kept.
-std::int64_t trim_csv(const std::string& path, std::int64_t rows) {
-  std::ifstream in(path, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::size_t end = 0;
-  std::int64_t kept = -1;  // the header is line 0
-  while (kept < rows) {
-    const std::size_t nl = text.find('\n', end);
-    if (nl == std::string::npos) break;
-    end = nl + 1;
-    ++kept;
-  }
-  io::write_file_atomic(path, text.substr(0, end));
-  return std::max<std::int64_t>(kept, 0);
-}
-
-class Outputs {
- public:
-  // `extra_header`: further CSV columns (CompactionObserver), starting with a comma; `restart`:
-  // the checkpoint a restarted run continues (nullptr: a new run); `history`: the checkpoint's
-  // folder when the restart writes to another folder ("" otherwise), from which the outputs
-  // written before the checkpoint are copied so that the new folder holds the whole run.
-  Outputs(const io::Config& cfg, const std::string& dir, const std::string& extra_header,
-          const checkpoint::State* restart, const std::string& history = "")
-      : cfg_(cfg), dir_(dir) {
-    fs::create_directories(dir_);
-    if (restart && !history.empty()) copy_history(history, *restart);
-    // Input copy, stamped with the version that ran it.
-    io::write_file_atomic(
-        (fs::path(dir_) / "input.toml").string(),
-        fmt::format("# run by mpmcd {} ({}) from {}\n", kVersion, kGitHash, cfg.source_path) +
-            cfg.source_text);
-    csv_path_ = (fs::path(dir_) / (cfg.simulation.name + ".csv")).string();
-    std::string header =
-        "step,time,dt,newton_iterations,linear_solves,kinetic_energy,elastic_energy,"
-        "total_energy,momentum_x,momentum_y,mass,volume,contacts,active_contacts,gs_sweeps";
-    for (const auto& w : cfg.walls) header += ",wall_" + w.name + "_fx,wall_" + w.name + "_fy";
-    header += extra_header + "\n";
-    if (restart && fs::exists(csv_path_)) {
-      csv_rows_ = trim_csv(csv_path_, restart->csv_rows);
-      if (csv_rows_ < restart->csv_rows)
-        log().warn("{} holds {} of the {} rows written before the checkpoint", csv_path_, csv_rows_,
-                   restart->csv_rows);
-      csv_rows_ = restart->csv_rows;
-      csv_.open(csv_path_, std::ios::binary | std::ios::app);
-    } else {
-      if (restart) log().warn("{} is missing: it restarts at step {}", csv_path_, restart->step);
-      csv_rows_ = restart ? restart->csv_rows : 0;
-      csv_.open(csv_path_, std::ios::binary | std::ios::trunc);
-      write_row(header);
-    }
-    if (!csv_) throw std::runtime_error("cannot open " + csv_path_);
-    if (cfg_.output.vtu)
-      pvd_ = std::make_unique<io::PvdSeries>(
-          (fs::path(dir_) / (cfg.simulation.name + ".pvd")).string());
-    if (restart && pvd_) {  // the series so far: file names follow from the snapshot index
-      int missing = 0;
-      for (const double t : restart->vtu_times) {
-        // Only snapshots that are in this folder: a series never lists a missing file.
-        const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
-        if (fs::exists(fs::path(dir_) / name))
-          pvd_->restore(t, name);
-        else
-          ++missing;
-        vtu_times_.push_back(t);
-        ++vtu_count_;
-      }
-      if (missing > 0)
-        log().warn(
-            "{} of the {} snapshots written before the checkpoint are not in {}: the .pvd "
-            "series lists the {} that are",
-            missing, vtu_count_, dir_, vtu_count_ - missing);
-    }
-  }
-  // Copies the outputs written up to the checkpoint from its folder `from`: the CSV (trimmed
-  // later to the checkpoint's rows) and every snapshot (points, contacts, pairs) it lists.
-  void copy_history(const std::string& from, const checkpoint::State& restart) {
-    const std::string& name = cfg_.simulation.name;
-    std::vector<std::string> files{name + ".csv"};
-    for (std::size_t k = 0; k < restart.vtu_times.size(); ++k)
-      for (const char* f : {"{}_{:06d}.vtu", "{}_contacts_{:06d}.vtu", "{}_pairs_{:06d}.csv"})
-        files.push_back(fmt::format(fmt::runtime(f), name, k));
-    int copied = 0;
-    for (const auto& f : files) {
-      const fs::path src = fs::path(from) / f, dst = fs::path(dir_) / f;
-      std::error_code ec;
-      if (!fs::is_regular_file(src, ec)) continue;
-      const fs::path tmp = dst.string() + ".tmp";  // atomic, as every output
-      fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
-      if (!ec) fs::rename(tmp, dst, ec);
-      if (ec)
-        throw std::runtime_error(
-            fmt::format("cannot copy '{}' to '{}': {}", src.string(), dst.string(), ec.message()));
-      ++copied;
-    }
-    log().info("restart into {}: copied {} files written before the checkpoint from {}", dir_,
-               copied, from);
-  }
-  // Restores the contact series of a restart (only runs with contact write it).
-  void restore_contacts(const mpm::ImplicitSolver<2>& solver) {
-    if (!pvd_ || !solver.settings().contact.enabled) return;
-    contacts_pvd_ = std::make_unique<io::PvdSeries>(
-        (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
-    for (std::size_t k = 0; k < vtu_times_.size(); ++k) {
-      const std::string name = fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, k);
-      if (fs::exists(fs::path(dir_) / name)) contacts_pvd_->restore(vtu_times_[k], name);
-    }
-  }
-  void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& st,
-               const mpm::Diagnostics<2>& d, const std::string& extra) {
-    std::string row = fmt::format(
-        "{},{:.12e},{:.6e},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", step, t,
-        dt, st.iterations, st.linear_solves, d.kinetic, d.elastic, d.kinetic + d.elastic,
-        d.momentum[0], d.momentum[1], d.mass, d.volume);
-    row += fmt::format(",{},{},{}", st.contacts, st.active_contacts, st.gs_sweeps);
-    for (std::size_t k = 0; k < cfg_.walls.size(); ++k) {
-      const bool have = k < st.wall_force.size();
-      row += fmt::format(",{:.12e},{:.12e}", have ? st.wall_force[k][0] : 0.0,
-                         have ? st.wall_force[k][1] : 0.0);
-    }
-    row += extra + "\n";
-    write_row(row);
-    ++csv_rows_;
-  }
-  void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
-           const contact::Problem<2>& problem, double t) {
-    if (!pvd_) return;
-    const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
-    write_points_vtu(model, (fs::path(dir_) / name).string());
-    if (solver.settings().contact.enabled) {
-      const std::string cname =
-          fmt::format("{}_contacts_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
-      const std::string pname =
-          fmt::format("{}_pairs_{:06d}.csv", cfg_.simulation.name, vtu_count_);
-      write_contacts(model, problem, (fs::path(dir_) / cname).string(),
-                     (fs::path(dir_) / pname).string());
-      if (!contacts_pvd_)
-        contacts_pvd_ = std::make_unique<io::PvdSeries>(
-            (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
-      contacts_pvd_->add(t, cname);
-    }
-    pvd_->add(t, name);  // last: a series lists only snapshots whose files are complete
-    vtu_times_.push_back(t);
-    ++vtu_count_;
-  }
-  /// CSV rows written so far (header excluded).
-  std::int64_t csv_rows() const { return csv_rows_; }
-  /// Times of the VTU snapshots written so far [s].
-  const std::vector<double>& vtu_times() const { return vtu_times_; }
-  const std::string& dir() const { return dir_; }
-  // Contacts as points at their nodes (normal, impulses, the two bodies; walls as -1 - index),
-  // and the per-pair aggregated contact force sum P / dt as a CSV.
-  void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& pb,
-                      const std::string& vtu_path, const std::string& csv_path) {
-    io::VtuPointCloud vtu(pb.contacts.size());
-    auto& normal = vtu.add_array("normal", 3);
-    auto& pn = vtu.add_array("normal_impulse", 1);
-    auto& pt = vtu.add_array("tangential_impulse", 1);
-    auto& force = vtu.add_array("force", 3);
-    auto& gap = vtu.add_array("gap", 1);
-    auto& body_a = vtu.add_int_array("body_a");
-    auto& body_b = vtu.add_int_array("body_b");
-    std::map<std::pair<int, int>, Vec<2>> pairs;
-    const double inv_dt = pb.dt > 0 ? 1.0 / pb.dt : 0.0;
-    for (std::size_t i = 0; i < pb.contacts.size(); ++i) {
-      const auto& c = pb.contacts[i];
-      const auto& sb = pb.slots[c.b];
-      const Vec<2> x = model.grid.node_position(model.grid.node_coords(sb.node));
-      vtu.set_position(i, x[0], x[1]);
-      normal[3 * i] = c.normal[0];
-      normal[3 * i + 1] = c.normal[1];
-      pn[i] = c.impulse.dot(c.normal);
-      pt[i] = c.impulse[1] * c.normal[0] - c.impulse[0] * c.normal[1];  // along t = e_z x n
-      force[3 * i] = c.impulse[0] * inv_dt;
-      force[3 * i + 1] = c.impulse[1] * inv_dt;
-      gap[i] = c.gap;
-      body_a[i] = c.a >= 0 ? pb.slots[c.a].grain : -1 - c.wall;
-      body_b[i] = sb.grain;
-      // try_emplace with an explicit zero: Eigen vectors are not zero-initialised.
-      pairs.try_emplace({body_a[i], body_b[i]}, Vec<2>::Zero()).first->second += c.impulse * inv_dt;
-    }
-    vtu.write(vtu_path);
-    std::string text = "body_a,body_b,force_x,force_y\n";
-    for (const auto& [key, f] : pairs)
-      text += fmt::format("{},{},{:.12e},{:.12e}\n", key.first, key.second, f[0], f[1]);
-    io::write_file_atomic(csv_path, text);
-  }
-  std::string last_good(const mpm::Model<2>& model) {
-    const std::string path = (fs::path(dir_) / (cfg_.simulation.name + "_last_good.vtu")).string();
-    write_points_vtu(model, path);
-    return path;
-  }
-
- private:
-  const io::Config& cfg_;
-  std::string dir_, csv_path_;
-  // One whole row per write, flushed: a crash leaves complete rows (a torn last line, possible
-  // only if the disk fills up, is dropped on restart).
-  void write_row(const std::string& row) {
-    csv_.write(row.data(), static_cast<std::streamsize>(row.size()));
-    csv_.flush();
-    if (!csv_)
-      throw std::runtime_error(fmt::format("cannot write '{}': {}", csv_path_,
-                                           std::strerror(errno)));  // e.g. no space left
-  }
-
-  std::ofstream csv_;
-  std::unique_ptr<io::PvdSeries> pvd_, contacts_pvd_;
-  int vtu_count_ = 0;
-  std::int64_t csv_rows_ = 0;
-  std::vector<double> vtu_times_;
-};
-
-}  // namespace
-
-namespace {
-
-// SIGINT / SIGTERM: the handler only records the signal; the loop finishes its step, writes a
-// checkpoint and returns. SA_RESETHAND: a second signal gets the default action (stops at once).
+// The last SIGINT or SIGTERM caught while a SignalGuard is alive (0: none); Run::between_steps
+// acts on it after the step.
 volatile std::sig_atomic_t g_signal = 0;
 
 extern "C" void on_stop_signal(int sig) {
   g_signal = sig;
 }
 
-class SignalGuard {
- public:
-  SignalGuard() {
-    g_signal = 0;
-    struct sigaction sa = {};
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESETHAND;
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~SignalGuard() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  SignalGuard(const SignalGuard&) = delete;
-  SignalGuard& operator=(const SignalGuard&) = delete;
-
- private:
-  struct sigaction old_int_ = {}, old_term_ = {};
-};
-
 const char* signal_name(int sig) {
   return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal";
 }
 
-// The model of a restart: grid and materials from the input, points and grains from the
-// checkpoint (no packing is regenerated). Throws InputError if they do not fit together.
-mpm::Model<2> restore_model(const io::Config& cfg, const checkpoint::State& s,
-                            const std::string& path) {
-  const auto refuse = [&](const std::string& what) {
-    return InputError(path, 0, "", "checkpoint does not fit its input: " + what);
-  };
-  if (s.dim != 2) throw refuse(fmt::format("dimension {}", s.dim));
-  mpm::Model<2> model = model_frame(cfg);
-  const std::size_t n = s.points();
-  auto& p = model.points;
-  p.x.resize(n);
-  p.v.resize(n);
-  p.L.resize(n);
-  p.F.resize(n);
-  p.sigma.resize(n);
-  p.domain.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    p.x[i] = Vec<2>(s.x[2 * i], s.x[2 * i + 1]);
-    p.v[i] = Vec<2>(s.v[2 * i], s.v[2 * i + 1]);
-    p.L[i] << s.L[4 * i], s.L[4 * i + 1], s.L[4 * i + 2], s.L[4 * i + 3];
-    p.F[i] << s.F[4 * i], s.F[4 * i + 1], s.F[4 * i + 2], s.F[4 * i + 3];
-    p.sigma[i] << s.sigma[4 * i], s.sigma[4 * i + 1], s.sigma[4 * i + 2], s.sigma[4 * i + 3];
-    p.domain[i] << s.domain[4 * i], s.domain[4 * i + 1], s.domain[4 * i + 2], s.domain[4 * i + 3];
-  }
-  p.sigma_zz = s.sigma_zz;
-  p.mass = s.mass;
-  p.volume0 = s.volume0;
-  p.volume = s.volume;
-  p.grain = s.grain;
-  p.history = s.history;
-  for (std::size_t g = 0; g < s.grain_begin.size(); ++g) {
-    points::Grain gr;
-    gr.begin = s.grain_begin[g];
-    gr.end = s.grain_end[g];
-    gr.material = s.grain_material[g];
-    gr.half_width = s.grain_half_width[g];
-    gr.history_offset = s.grain_history_offset[g];
-    if (gr.material >= static_cast<int>(model.laws.size()))
-      throw refuse(fmt::format("grain {} has material {}, the input has {} materials", g,
-                               gr.material, model.laws.size()));
-    const std::int64_t hs = model.laws[gr.material]->history_size();
-    if (gr.history_offset + hs * gr.size() > static_cast<std::int64_t>(p.history.size()))
-      throw refuse(fmt::format("grain {}: history shorter than its law needs", g));
-    model.grains.push_back(gr);
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    if (!model.grid.inside(p.x[i], 0.0))
-      throw refuse(fmt::format("point {} lies outside the grid", i));
-  const auto ng = static_cast<std::int32_t>(model.grains.size());
-  const auto nwall = static_cast<std::int32_t>(cfg.walls.size());
-  for (std::size_t k = 0; k < s.warm_node.size(); ++k)
-    if (s.warm_node[k] < -model.grid.node_count() || s.warm_node[k] >= model.grid.node_count() ||
-        s.warm_b[k] < 0 || s.warm_b[k] >= ng || s.warm_a[k] >= ng || s.warm_a[k] < -nwall)
-      throw refuse(
-          fmt::format("contact warm-start entry {} names a node or body that does not "
-                      "exist",
-                      k));
-  if (s.wall_point.size() != 2 * cfg.walls.size())
-    throw refuse(fmt::format("{} walls in the checkpoint, {} in the input", s.wall_point.size() / 2,
-                             cfg.walls.size()));
-  return model;
+// The model of the run, after the thread count is set (a packing input runs its DEM on the
+// threads): restored from the checkpoint `restart`, or built from the input.
+mpm::Model<2> initial_model(const io::Config& cfg, const RunOptions& opt,
+                            const checkpoint::State* restart) {
+  const int threads = opt.threads > 0 ? opt.threads : cfg.simulation.threads;
+  if (threads > 0) omp_set_num_threads(threads);
+  return restart ? restore_model<2>(cfg, *restart, opt.restart) : build_model(cfg);
 }
 
-// The files of the run named `name` in `folder` (docs/robustness.md, "Output folders"): the
-// input copy and every output named after the run, with the .tmp files a crash may leave.
-std::vector<std::string> run_files(const std::string& folder, const std::string& name) {
-  const std::regex own("(input\\.toml|" + io::regex_escape(name) +
-                       "(\\.csv|\\.pvd|_contacts\\.pvd|_[0-9]{6}\\.vtu|_contacts_[0-9]{6}\\.vtu|"
-                       "_pairs_[0-9]{6}\\.csv|_checkpoint_[0-9]{9}\\.h5|_last_good\\.vtu|"
-                       "_timers\\.csv))(\\.tmp)?");
-  return io::files_in(folder, [&](const std::string& f) { return std::regex_match(f, own); });
+// The solver settings; a new run's walls must enclose its grains.
+mpm::Settings<2> checked_settings(const io::Config& cfg, const mpm::Model<2>& model, bool restart) {
+  auto settings = build_settings(cfg);
+  if (!restart) check_walls_enclose(cfg, model, settings);
+  return settings;
 }
 
-// The run name in an input copy (<folder>/input.toml) of an earlier run: [simulation] name, by
-// default "mpmcd"; "" if the file cannot be read.
-std::string earlier_run_name(const fs::path& input_copy) {
-  std::ifstream in(input_copy);
-  if (!in) return "";
-  const std::regex table(R"re(\s*\[\s*([A-Za-z0-9_.]+)\s*\].*)re");
-  const std::regex key(R"re(\s*name\s*=\s*"([A-Za-z0-9_.-]+)".*)re");
-  std::string line, section, name = io::Config{}.simulation.name;
-  std::smatch m;
-  while (std::getline(in, line)) {
-    if (std::regex_match(line, m, table))
-      section = m[1];
-    else if (section == "simulation" && std::regex_match(line, m, key))
-      name = m[1];
-  }
-  return name;
-}
-
-// One folder, one run: a new run (or a restart written elsewhere than its checkpoint's folder)
-// refuses a folder that holds input.toml or files of a run of this name, unless `overwrite`,
-// which removes them, and those of the run named in the old input.toml, first. Rank 0 looks and
-// tells the others.
-void claim_run_folder(const io::Config& cfg, const RunOptions& opt, const std::string& dir,
-                      const parallel::Comm& comm) {
-  std::vector<char> verdict;
-  if (comm.rank() == 0) {
-    try {
-      auto files = run_files(dir, cfg.simulation.name);
-      const std::string earlier = earlier_run_name(fs::path(dir) / "input.toml");
-      if (opt.overwrite && !earlier.empty() && earlier != cfg.simulation.name)
-        for (auto& f : run_files(dir, earlier)) files.push_back(f);
-      std::sort(files.begin(), files.end());
-      files.erase(std::unique(files.begin(), files.end()), files.end());
-      const std::string what =
-          earlier.empty() || earlier == cfg.simulation.name
-              ? fmt::format("run named '{}'", cfg.simulation.name)
-              : fmt::format("run (named '{}', this one '{}')", earlier, cfg.simulation.name);
-      io::claim_output_folder(dir, files, opt.overwrite, what,
-                              opt.restart.empty() ? cfg.source_path : opt.restart,
-                              opt.output_dir.empty() ? "output.folder" : "-o");
-      if (opt.overwrite && !files.empty())
-        log().info("--overwrite: removed {} files of the earlier run in {}", files.size(), dir);
-    } catch (const InputError& e) {
-      const std::string m = e.what();
-      verdict.assign(m.begin(), m.end());
-    }
-  }
-  if (comm.size() > 1) comm.broadcast(verdict, 0);
-  if (!verdict.empty()) throw InputError(std::string(verdict.begin(), verdict.end()));
+// The energy ledger's sums where the run starts: the checkpoint's, or zero sums from the model's
+// energy at t = 0 (every rank holds the initial points).
+EnergySums start_energy(const io::Config& cfg, const mpm::Model<2>& model,
+                        const checkpoint::State* restart) {
+  return restart ? energy_sums_of(*restart)
+                 : EnergyLedger<2>::start(cfg.walls.size(), mpm::diagnostics(model));
 }
 
 }  // namespace
 
-Restart load_restart(const std::string& path, const std::string& input) {
-  Restart r;
-  r.path = path;
-  r.state = checkpoint::read(path);
-  if (input.empty()) {
-    r.config = io::parse_config(r.state.input_text, r.state.input_path);
-  } else {
-    r.config = io::load_config(input);
-    if (checkpoint::fnv1a(r.config.source_text) != r.state.input_hash)
-      throw InputError(input, 0, "",
-                       fmt::format("this input is not the one checkpoint '{}' was written from "
-                                   "({}); a restart continues the same run: give that input or "
-                                   "none (the checkpoint holds it)",
-                                   path, r.state.input_path));
-  }
-  return r;
+namespace detail {
+
+SignalGuard::SignalGuard() {
+  g_signal = 0;
+  struct sigaction sa = {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &sa, &old_int_);
+  sigaction(SIGTERM, &sa, &old_term_);
 }
 
-RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
-                          const checkpoint::State* restart) {
-  RunSummary summary;
-  const int threads = opt.threads > 0 ? opt.threads : cfg.simulation.threads;
-  if (threads > 0) omp_set_num_threads(threads);
-  // May throw InputError: before any output.
-  mpm::Model<2> model = restart ? restore_model(cfg, *restart, opt.restart) : build_model(cfg);
-  auto settings = build_settings(cfg);
-  if (!restart) check_walls_enclose(cfg, model, settings);
-  bool any_moving = false;
-  for (const auto& b : cfg.boundaries) any_moving = any_moving || b.moving;
+SignalGuard::~SignalGuard() {
+  sigaction(SIGINT, &old_int_, nullptr);
+  sigaction(SIGTERM, &old_term_, nullptr);
+}
 
-  summary.output_dir = opt.output_dir.empty() ? cfg.output.folder : opt.output_dir;
-  if (restart && opt.output_dir.empty()) {  // continue where the checkpoint lies
-    const fs::path parent = fs::path(opt.restart).parent_path();
-    summary.output_dir = parent.empty() ? "." : parent.string();
-  } else if (fs::path(summary.output_dir).is_relative() && opt.output_dir.empty()) {
-    summary.output_dir =
-        (fs::path(cfg.source_path).parent_path() / summary.output_dir).lexically_normal().string();
-  }
-  const CompactionObserver observer(cfg, model);
-  // Processes (docs/parallel.md): every rank holds the model and computes its grains; rank 0
-  // gathers the state at output and checkpoint times and writes every file.
-  const auto& comm = parallel::Comm::world();
-  const bool root = comm.rank() == 0;
-  if (!root) log().set_level(spdlog::level::off);  // rank 0 reports
-  std::string history_dir;  // a restart written elsewhere: the checkpoint's folder
-  {  // a restart continues in its checkpoint's folder; anywhere else the folder must be free
-    std::error_code ec;
-    const fs::path ckpt_dir = restart ? (fs::path(opt.restart).parent_path().empty()
-                                             ? fs::path(".")
-                                             : fs::path(opt.restart).parent_path())
-                                      : fs::path();
-    const bool continuing = restart && fs::equivalent(ckpt_dir, summary.output_dir, ec);
-    if (!continuing) claim_run_folder(cfg, opt, summary.output_dir, comm);
-    if (restart && !continuing) history_dir = ckpt_dir.string();
-  }
-  SignalGuard signals;
-  mpm::ImplicitSolver<2> solver(model.grid, settings, model.points, model.grains, model.law_ptrs());
-  solver.set_boundary_conditions(build_boundaries(cfg, model.grid, 0.0));
-  const parallel::Scheme scheme =
-      parallel::scheme_from_string(opt.scheme.empty() ? "partition" : opt.scheme);
-  // A restart on the same ranks and scheme keeps the checkpoint's distribution and re-balancing
-  // counts (bitwise continuation); otherwise the grains are dealt again from the restored state.
-  const bool keep =
-      restart && restart->ranks == comm.size() && restart->scheme == parallel::to_string(scheme);
-  if (comm.size() > 1) {
-    std::vector<int> owner =
-        keep ? std::vector<int>(restart->grain_owner.begin(), restart->grain_owner.end())
-             : parallel::deal_grains(model.points, model.grains, scheme, comm.size());
-    solver.set_distribution(&comm, owner, scheme);
-  }
-  if (keep) {
-    std::vector<double> work(restart->grain_work);
-    for (std::size_t g = 0; g < restart->grain_owner.size(); ++g)
-      if (restart->grain_owner[g] != comm.rank())
-        std::fill_n(work.begin() + static_cast<std::ptrdiff_t>(g * parallel::kWorkPhases),
-                    parallel::kWorkPhases, 0.0);
-    solver.set_grain_work(std::move(work));
-  }
-  // Energy ledger (docs/accuracy.md): the work done by each wall on the grains, W_k += -F_k . v_k
-  // dt with F_k the grains' force on wall k over the step, and by the body forces, against the
-  // change of elastic plus kinetic energy since t = 0. What is lost on the way: contact
-  // dissipates D_c += sum_k W_k(step) - W_c(step), W_c the work of all contact impulses on the
-  // grains (StepStats::contact_work); the transfers D_t (StepStats::transfer_loss); the stress
-  // work on the grid not stored as elastic energy, D_i = -sum W_int - (Psi - Psi_0) (plastic
-  // dissipation; for elastic laws, time integration and quadrature). The remainder is the
-  // Newton tolerance's (and prescribed grid velocities' work).
-  std::vector<double> wall_work(cfg.walls.size(), 0.0);
-  double energy0 = 0, kinetic0 = 0, contact_dissipation = 0, transfer_dissipation = 0;
-  double stress_work = 0, body_work = 0;
-  if (restart) {
-    wall_work = restart->wall_work;
-    energy0 = restart->energy0;
-    kinetic0 = restart->kinetic0;
-    contact_dissipation = restart->contact_dissipation;
-    transfer_dissipation = restart->transfer_dissipation;
-    stress_work = restart->stress_work;
-    body_work = restart->body_work;
-  } else {
-    const auto d0 = mpm::diagnostics(model);  // every rank holds the initial points
-    energy0 = d0.elastic + d0.kinetic;
-    kinetic0 = d0.kinetic;
-  }
-  std::string ledger_header;
-  for (const auto& w : cfg.walls) ledger_header += ",wall_" + w.name + "_work";
-  if (!cfg.walls.empty())
-    ledger_header +=
-        ",body_work,energy_change,contact_dissipation,transfer_dissipation,internal_dissipation,"
-        "energy_unaccounted";
-  // The ledger's terms from the diagnostics d of the current points: {sum of the walls' work,
-  // E - E0, internal dissipation D_i, remainder}.
-  struct Ledger {
-    double walls, change, internal, rest;
-  };
-  const auto ledger = [&](const mpm::Diagnostics<2>& d) {
-    Ledger l{0, d.elastic + d.kinetic - energy0, 0, 0};
-    for (const double w : wall_work) l.walls += w;
-    l.internal = -stress_work - (d.elastic - (energy0 - kinetic0));
-    l.rest =
-        l.walls + body_work - contact_dissipation - transfer_dissipation - l.internal - l.change;
-    return l;
-  };
-  std::unique_ptr<Outputs> out_ptr;  // after every input check: nothing written before
-  if (root)
-    out_ptr = std::make_unique<Outputs>(
-        cfg, summary.output_dir, observer.csv_header() + ledger_header, restart, history_dir);
-  // The ledger's CSV fields: work of each wall and of the body forces, E - E0, the contact,
-  // transfer and internal dissipations, and the remainder.
-  const auto ledger_fields = [&](const mpm::Diagnostics<2>& d) {
-    std::string f;
-    if (wall_work.empty()) return f;  // the ledger is written by runs with walls
-    for (const double w : wall_work) f += fmt::format(",{:.12e}", w);
-    const Ledger l = ledger(d);
-    return f + fmt::format(",{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", body_work, l.change,
-                           contact_dissipation, transfer_dissipation, l.internal, l.rest);
-  };
-  const bool stop_active = cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0;
-  const auto gather_state = [&](int to) {
-    ScopedStage ts(&solver.timers(), "output");
-    parallel::gather_points(comm, model.points, model.grains, solver.owner(), to);
-  };
-
+Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* restart)
+    : cfg_(cfg),
+      opt_(opt),
+      restart_(restart),
+      model_(initial_model(cfg, opt, restart)),
+      settings_(checked_settings(cfg, model_, restart != nullptr)),
+      observer_(cfg, model_),
+      comm_(parallel::Comm::world()),
+      root_(comm_.rank() == 0),
+      scheme_(parallel::scheme_from_string(opt.scheme.empty() ? "partition" : opt.scheme)),
+      any_moving_(std::any_of(cfg.boundaries.begin(), cfg.boundaries.end(),
+                              [](const auto& b) { return b.moving; })),
+      stop_active_(cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0),
+      ledger_(start_energy(cfg, model_, restart)),
+      dt_control_(cfg.time),
+      progress_(cfg.time.end_time, cfg.stop, observer_.initial_phi()),
+      t_(restart ? restart->time : 0.0),
+      next_vtu_(restart ? restart->next_vtu : 0.0),
+      next_csv_(restart ? restart->next_csv : 0.0),
+      steps0_(restart ? restart->step : 0),
+      last_checkpoint_step_(restart ? restart->step : -1) {
+  summary_.output_dir = output_folder(cfg, opt, restart != nullptr);
+  if (!root_) log().set_level(spdlog::level::off);  // rank 0 reports
+  // A restart written elsewhere than its checkpoint: the checkpoint's folder, its history.
+  const std::string history_dir =
+      prepare_output_folder(cfg, opt, summary_.output_dir, restart != nullptr, comm_);
+  signals_.emplace();
+  solver_ = std::make_unique<mpm::ImplicitSolver<2>>(model_.grid, settings_, model_.points,
+                                                     model_.grains, model_.law_ptrs());
+  solver_->set_boundary_conditions(build_boundaries(cfg, model_.grid, 0.0));
+  distribute();
+  if (root_)  // after every input check: nothing written before
+    out_ = std::make_unique<Outputs>(cfg, summary_.output_dir,
+                                     observer_.csv_header() + EnergyLedger<2>::csv_header(cfg),
+                                     restart, history_dir);
   log().info(
       "mpmcd {} ({}): {} grains, {} material points, grid {}x{} cells of {} m, {} rank(s) x {} "
       "threads",
-      kVersion, kGitHash, model.grains.size(), model.points.size(), model.grid.cells()[0],
-      model.grid.cells()[1], model.grid.cell_size(), comm.size(), omp_get_max_threads());
-  const double dt_nominal = cfg.time.dt, t_end = cfg.time.end_time;
-  double t = 0, dt = dt_nominal;
-  std::int64_t good_since_cut = 0;
-  double next_vtu = 0, next_csv = 0;
+      kVersion, kGitHash, model_.grains.size(), model_.points.size(), model_.grid.cells()[0],
+      model_.grid.cells()[1], model_.grid.cell_size(), comm_.size(), omp_get_max_threads());
   if (restart) {
-    t = restart->time;
-    dt = restart->dt;
-    good_since_cut = restart->good_since_cut;
-    next_vtu = restart->next_vtu;
-    next_csv = restart->next_csv;
-    summary.steps = restart->step;
-    summary.failed_steps = restart->failed_steps;
-    summary.newton_iterations = restart->newton_iterations;
+    dt_control_.restore(restart->dt, restart->good_since_cut);
+    summary_.steps = restart->step;
+    summary_.failed_steps = restart->failed_steps;
+    summary_.newton_iterations = restart->newton_iterations;
     // Every rank gets every impulse; a rank looks up only the contacts it solves.
-    std::vector<mpm::WarmImpulse<2>> warm(restart->warm_node.size());
-    for (std::size_t k = 0; k < warm.size(); ++k)
-      warm[k] = {restart->warm_node[k], restart->warm_a[k], restart->warm_b[k],
-                 Vec<2>(restart->warm_impulse[2 * k], restart->warm_impulse[2 * k + 1])};
-    solver.set_warm_start(std::move(warm));
-    if (root) out_ptr->restore_contacts(solver);
+    solver_->set_warm_start(warm_start_of<2>(*restart));
+    if (root_) out_->restore_contacts(*solver_);
     log().info("restarted from {} (written by mpmcd {} on {} rank(s)): step {}, t = {:.9g} s",
-               opt.restart, restart->mpmcd_version, restart->ranks, summary.steps, t);
+               opt.restart, restart->mpmcd_version, restart->ranks, summary_.steps, t_);
     // The order of the threads' floating-point sums changes with their count (docs/robustness.md).
     if (restart->threads != omp_get_max_threads())
       log().warn(
@@ -927,351 +148,188 @@ RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
   }
   // Runs driven faster than the grains can follow (docs/robustness.md): walls at the start,
   // material points at output times (rank 0 then holds every point), each reported once.
-  if (const auto w = fast_wall_warning(cfg, model)) log().warn("{}", *w);
-  bool fast_points_reported = false;
-  mpm::StepStats last;
-  auto record = [&](bool force) {
-    const double eps = 1e-9 * dt_nominal;
-    const bool csv = force || t >= next_csv - eps, vtu = force || t >= next_vtu - eps;
-    if (!csv && !vtu) return;
-    if (comm.size() > 1) gather_state(0);
-    if (root && !fast_points_reported)
-      if (const auto w = fast_point_warning(cfg, model, t)) {
-        log().warn("{}", *w);
-        fast_points_reported = true;
-      }
-    ScopedStage ts(&solver.timers(), "output");
-    const auto problem = parallel::gather_contacts(comm, solver.contact_problem(), 0);
-    if (csv) {
-      if (root) {
-        const auto d = mpm::diagnostics(model);
-        out_ptr->csv_row(summary.steps, t, dt, last, d,
-                         observer.csv_fields(model, last, problem, t) + ledger_fields(d));
-      }
-      next_csv = t + cfg.output.csv_interval;
-    }
-    if (vtu) {
-      if (root) out_ptr->vtu(model, solver, problem, t);
-      next_vtu = t + cfg.output.vtu_interval;
-    }
-  };
-  // Writes the checkpoint of the committed state (collective: rank 0 gathers every grain and
-  // every rank's warm-start impulses and writes one file); returns its path on rank 0.
-  std::int64_t last_checkpoint_step = restart ? restart->step : -1;
-  auto write_checkpoint = [&](const std::string& reason) {
-    ScopedStage ts(&solver.timers(), "checkpoint");
-    if (comm.size() > 1) gather_state(0);
-    // Warm-start impulses of every rank (each contact is solved by one rank).
-    const auto warm = solver.gather_warm_start();
-    std::vector<double> work = solver.grain_work();
-    work.resize(model.grains.size() * parallel::kWorkPhases, 0.0);
-    comm.sum(work);
-    last_checkpoint_step = summary.steps;
-    if (!root) return std::string();
-    Outputs& out = *out_ptr;
-    checkpoint::State s;
-    s.dim = 2;
-    s.input_text = cfg.source_text;
-    s.input_path = cfg.source_path;
-    s.reason = reason;
-    s.step = summary.steps;
-    s.time = t;
-    s.dt = dt;
-    s.good_since_cut = good_since_cut;
-    s.failed_steps = summary.failed_steps;
-    s.newton_iterations = summary.newton_iterations;
-    s.next_vtu = next_vtu;
-    s.next_csv = next_csv;
-    s.csv_rows = out.csv_rows();
-    s.vtu_times = out.vtu_times();
-    const auto& p = model.points;
-    const std::size_t n = p.size();
-    s.x.resize(2 * n);
-    s.v.resize(2 * n);
-    s.L.resize(4 * n);
-    s.F.resize(4 * n);
-    s.sigma.resize(4 * n);
-    s.domain.resize(4 * n);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < 2; ++a) {
-        s.x[2 * i + a] = p.x[i][a];
-        s.v[2 * i + a] = p.v[i][a];
-        for (int b = 0; b < 2; ++b) {
-          s.L[4 * i + 2 * a + b] = p.L[i](a, b);
-          s.F[4 * i + 2 * a + b] = p.F[i](a, b);
-          s.sigma[4 * i + 2 * a + b] = p.sigma[i](a, b);
-          s.domain[4 * i + 2 * a + b] = p.domain[i](a, b);
-        }
-      }
-    s.sigma_zz = p.sigma_zz;
-    s.mass = p.mass;
-    s.volume0 = p.volume0;
-    s.volume = p.volume;
-    s.grain = p.grain;
-    s.history = p.history;
-    for (const auto& g : model.grains) {
-      s.grain_begin.push_back(g.begin);
-      s.grain_end.push_back(g.end);
-      s.grain_material.push_back(g.material);
-      s.grain_half_width.push_back(g.half_width);
-      s.grain_history_offset.push_back(g.history_offset);
-    }
-    for (const auto& w : warm) {
-      s.warm_node.push_back(w.node);
-      s.warm_a.push_back(w.a);
-      s.warm_b.push_back(w.b);
-      s.warm_impulse.push_back(w.impulse[0]);
-      s.warm_impulse.push_back(w.impulse[1]);
-    }
-    for (const auto& w : settings.contact.walls) {
-      const Vec<2> x = w.point + t * w.velocity;
-      s.wall_point.push_back(x[0]);
-      s.wall_point.push_back(x[1]);
-    }
-    s.ranks = comm.size();
-    s.scheme = parallel::to_string(scheme);
-    s.threads = omp_get_max_threads();
-    s.grain_owner.assign(model.grains.size(), 0);
-    if (comm.size() > 1)
-      for (std::size_t g = 0; g < model.grains.size(); ++g) s.grain_owner[g] = solver.owner()[g];
-    s.grain_work = work;
-    s.wall_work = wall_work;
-    s.energy0 = energy0;
-    s.contact_dissipation = contact_dissipation;
-    s.kinetic0 = kinetic0;
-    s.transfer_dissipation = transfer_dissipation;
-    s.stress_work = stress_work;
-    s.body_work = body_work;
-    const std::string path =
-        (fs::path(out.dir()) / checkpoint::file_name(cfg.simulation.name, s.step)).string();
-    checkpoint::write(s, path);
-    checkpoint::prune(out.dir(), cfg.simulation.name, cfg.checkpoint.keep);
-    summary.checkpoint = path;
-    log().info("checkpoint ({}) at step {}, t = {:.9g} s: {}", reason, s.step, t, path);
-    return path;
-  };
-  if (!restart) record(true);
-  comm.record_syncs();  // the serial fraction, measured at every synchronisation
-  const auto wall0 = std::chrono::steady_clock::now();
-  auto last_progress = wall0, last_checkpoint_wall = wall0;
-  const std::int64_t steps0 = summary.steps;
-  // Progress toward the criterion that will end the run (docs/robustness.md, "Progress"): the
-  // compaction state of the committed step (collective: the grains' area is summed over ranks).
-  ProgressEstimator progress(t_end, cfg.stop, observer.initial_phi());
-  const auto progress_sample = [&](const mpm::StepStats& st, double wall) {
-    ProgressSample s{wall, t, std::nullopt, std::nullopt, std::nullopt};
-    if (!observer.has_box()) return std::make_pair(s, std::optional<CompactionObserver::Now>());
-    std::vector<double> areas = CompactionObserver::grain_areas(
-        model, comm.size() > 1 ? &solver.owner() : nullptr, comm.rank());
-    if (comm.size() > 1) comm.sum(areas);
-    const auto now = observer.now(CompactionObserver::total_area(areas), st, t);
-    s.phi = now->phi;
-    s.strain = now->strain;
-    if (!st.wall_force.empty()) s.stress = -now->bottom_stress;  // none before the first step
-    return std::make_pair(s, now);
-  };
-  if (!opt.quiet) progress.add(progress_sample(last, 0.0).first);
-  while (t < t_end - 1e-9 * dt_nominal) {
-    const double dt_try = std::min(dt, t_end - t);
-    solver.set_time(t);
-    if (any_moving) solver.set_boundary_conditions(build_boundaries(cfg, model.grid, t + dt_try));
-    mpm::StepStats st = solver.solve_step(dt_try);
+  if (const auto w = fast_wall_warning(cfg, model_)) log().warn("{}", *w);
+}
+
+// Deals the grains to the ranks. A restart on the same ranks and scheme keeps the checkpoint's
+// distribution and re-balancing counts (bitwise continuation); otherwise the grains are dealt
+// again from the restored state.
+void Run::distribute() {
+  const bool keep = restart_ && restart_->ranks == comm_.size() &&
+                    restart_->scheme == parallel::to_string(scheme_);
+  if (comm_.size() > 1) {
+    std::vector<int> owner =
+        keep ? std::vector<int>(restart_->grain_owner.begin(), restart_->grain_owner.end())
+             : parallel::deal_grains(model_.points, model_.grains, scheme_, comm_.size());
+    solver_->set_distribution(&comm_, owner, scheme_);
+  }
+  if (keep) {
+    std::vector<double> work(restart_->grain_work);
+    for (std::size_t g = 0; g < restart_->grain_owner.size(); ++g)
+      if (restart_->grain_owner[g] != comm_.rank())
+        std::fill_n(work.begin() + static_cast<std::ptrdiff_t>(g * parallel::kWorkPhases),
+                    parallel::kWorkPhases, 0.0);
+    solver_->set_grain_work(std::move(work));
+  }
+}
+
+// Commits the converged step of length dt [s]: points, energy ledger, re-balancing, counters.
+void Run::commit(const mpm::StepStats& st, double dt) {
+  solver_->commit();
+  last_ = st;
+  ledger_.add_step(st, settings_.contact.walls, dt);
+  if (comm_.size() > 1 && scheme_ == parallel::Scheme::kPartition && opt_.rebalance > 0 &&
+      (summary_.steps + 1) % 50 == 0)  // docs/parallel.md: deterministic work weights
+    rebalance();
+  t_ += dt;
+  ++summary_.steps;
+  summary_.newton_iterations += st.iterations;
+  if (dt_control_.succeeded())
+    log().info("dt restored to {:.4g} s at t = {:.9g} s", dt_control_.dt(), t_);
+}
+
+// Deals the grains again when the work imbalance exceeds --rebalance (collective).
+void Run::rebalance() {
+  ScopedStage ts(&solver_->timers(), "rebalance");
+  auto owner = solver_->owner();
+  bool moved = false;
+  const double imbalance = parallel::rebalance(comm_, model_.points, model_.grains, owner,
+                                               solver_->take_grain_work(), opt_.rebalance, moved);
+  if (moved) {
+    solver_->set_distribution(&comm_, owner, scheme_);
+    log().info("step {}: work imbalance {:.3f} > {}: grains dealt again", summary_.steps + 1,
+               imbalance, opt_.rebalance);
+  }
+}
+
+// The [stop] criterion reached by the committed step, if any. Phi needs every grain's area: on
+// several ranks each one's grains, summed per grain over the ranks (exact: the other ranks add
+// zeros), then over the grains in order, as one process does.
+std::optional<std::string> Run::stop_criterion(const mpm::StepStats& st) {
+  if (!stop_active_) return std::nullopt;
+  if (comm_.size() == 1) return observer_.stop_reason(model_, st, t_);
+  ScopedStage ts(&solver_->timers(), "output");
+  auto areas = CompactionObserver::grain_areas(model_, &solver_->owner(), comm_.rank());
+  comm_.sum(areas);
+  return observer_.stop_reason(CompactionObserver::total_area(areas), st, t_);
+}
+
+// After a committed step that did not end the run (`at_end`: it reached end_time): a signal or
+// --stop-after writes a checkpoint and returns false (stop); periodic checkpoints; the progress
+// line. Collective.
+bool Run::between_steps(const mpm::StepStats& st, bool at_end) {
+  const auto now = std::chrono::steady_clock::now();
+  const bool stop = opt_.stop_after > 0 && summary_.steps - steps0_ >= opt_.stop_after;
+  const bool due_steps =
+      cfg_.checkpoint.every_steps > 0 && summary_.steps % cfg_.checkpoint.every_steps == 0;
+  const auto since = [&](auto then) { return std::chrono::duration<double>(now - then).count(); };
+  // Signals and wall-clock deadlines reach the ranks at different times: they act when any rank
+  // has seen them, on every rank in the same step.
+  std::vector<double> flags{
+      static_cast<double>(g_signal),
+      cfg_.checkpoint.every_minutes > 0 &&
+              since(last_checkpoint_wall_) >= 60.0 * cfg_.checkpoint.every_minutes
+          ? 1.0
+          : 0.0,
+      !opt_.quiet && since(last_progress_) >= cfg_.output.progress_interval ? 1.0 : 0.0};
+  if (comm_.size() > 1) comm_.max(flags);
+  const int signal = static_cast<int>(flags[0]);
+  const bool due_wall = flags[1] > 0, due_progress = flags[2] > 0;
+  if ((signal != 0 || stop) && !at_end) {
+    summary_.signal = signal;
+    summary_.interrupted = true;
+    write_checkpoint(signal != 0 ? "signal" : "stop_after");
+    return false;
+  }
+  if ((due_steps || due_wall) && !(at_end && cfg_.checkpoint.at_end)) {
+    write_checkpoint("periodic");
+    last_checkpoint_wall_ = now;
+  }
+  if (due_progress) {  // the same step on every rank: the sample is collective
+    last_progress_ = now;
+    report_progress(st, since(wall0_));
+  }
+  return true;
+}
+
+RunSummary Run::go() {
+  if (!restart_) record(true);
+  comm_.record_syncs();  // the serial fraction, measured at every synchronisation
+  wall0_ = last_progress_ = last_checkpoint_wall_ = std::chrono::steady_clock::now();
+  if (!opt_.quiet) progress_.add(progress_sample(last_, 0.0).first);
+  const double t_end = cfg_.time.end_time, eps = 1e-9 * cfg_.time.dt;
+  while (t_ < t_end - eps) {
+    const double dt = dt_control_.next(t_end - t_);
+    solver_->set_time(t_);
+    if (any_moving_) solver_->set_boundary_conditions(build_boundaries(cfg_, model_.grid, t_ + dt));
+    const mpm::StepStats st = solver_->solve_step(dt);
     if (!st.converged) {  // the same verdict on every rank (the solver reduces it)
-      ++summary.failed_steps;
-      const double dt_new = dt_try * cfg.time.cut_factor;
-      if (!st.retryable || dt_new < cfg.time.dt_min) {
-        if (comm.size() > 1) gather_state(0);
-        const std::string saved = root ? out_ptr->last_good(model) : std::string();
-        // Step summary.steps + 1 failed; the state of step summary.steps (time t) is the last
-        // good one: committed steps always keep every point's support on the grid (the solver
-        // checks the positions a step would commit), so its checkpoint can be resumed.
-        log().error("step {} failed; last good state (step {}, t = {:.9g} s) written to {}",
-                    summary.steps + 1, summary.steps, t, saved);
-        std::string ckpt;
-        try {
-          ckpt = write_checkpoint("failure");
-        } catch (const std::exception& e) {
-          log().error("no checkpoint of the last good state: {}", e.what());
-        }
-        std::string reason = st.retryable ? fmt::format(
-                                                "{}; dt cut down to dt_min = {:.3g} s "
-                                                "did not help",
-                                                st.failure, cfg.time.dt_min)
-                                          : st.failure;
-        reason += fmt::format(" in step {}, after the last good step {}", summary.steps + 1,
-                              summary.steps);
-        if (!ckpt.empty()) reason += fmt::format("; checkpoint of the last good step: {}", ckpt);
-        throw NumericalError(reason, summary.steps + 1, t, st.grain, st.point);
-      }
+      ++summary_.failed_steps;
+      if (!st.retryable || !dt_control_.cut(dt)) fail(st);
       log().warn("step {} at t = {:.9g} s failed ({}), retrying with dt = {:.4g} s",
-                 summary.steps + 1, t, st.failure, dt_new);
-      dt = dt_new;
-      good_since_cut = 0;
+                 summary_.steps + 1, t_, st.failure, dt_control_.dt());
       continue;
     }
-    solver.commit();
-    last = st;
-    double step_work = 0;
-    for (std::size_t k = 0; k < wall_work.size() && k < st.wall_force.size(); ++k) {
-      const double wk = -(st.wall_force[k][0] * settings.contact.walls[k].velocity[0] +
-                          st.wall_force[k][1] * settings.contact.walls[k].velocity[1]) *
-                        dt_try;
-      wall_work[k] += wk;
-      step_work += wk;
-    }
-    contact_dissipation += step_work - st.contact_work;
-    transfer_dissipation += st.transfer_loss;
-    stress_work += st.stress_work;
-    body_work += st.body_work;
-    if (comm.size() > 1 && scheme == parallel::Scheme::kPartition && opt.rebalance > 0 &&
-        (summary.steps + 1) % 50 == 0) {  // docs/parallel.md: deterministic work weights
-      ScopedStage ts(&solver.timers(), "rebalance");
-      auto owner = solver.owner();
-      bool moved = false;
-      const double imbalance = parallel::rebalance(comm, model.points, model.grains, owner,
-                                                   solver.take_grain_work(), opt.rebalance, moved);
-      if (moved) {
-        solver.set_distribution(&comm, owner, scheme);
-        log().info("step {}: work imbalance {:.3f} > {}: grains dealt again", summary.steps + 1,
-                   imbalance, opt.rebalance);
-      }
-    }
-    t += dt_try;
-    ++summary.steps;
-    summary.newton_iterations += st.iterations;
-    if (dt < dt_nominal && ++good_since_cut >= cfg.time.recover_steps) {
-      dt = std::min(dt_nominal, 2 * dt);
-      good_since_cut = 0;
-      log().info("dt restored to {:.4g} s at t = {:.9g} s", dt, t);
-    }
-    // [stop] criteria. Phi needs every grain's area: on several ranks each one's grains, summed
-    // per grain over the ranks (exact: the other ranks add zeros), then over the grains in
-    // order, as one process does.
-    std::optional<std::string> criterion;
-    if (stop_active && comm.size() > 1) {
-      ScopedStage ts(&solver.timers(), "output");
-      auto areas = CompactionObserver::grain_areas(model, &solver.owner(), comm.rank());
-      comm.sum(areas);
-      criterion = observer.stop_reason(CompactionObserver::total_area(areas), st, t);
-    } else if (stop_active) {
-      criterion = observer.stop_reason(model, st, t);
-    }
-    const bool at_end = criterion.has_value() || t >= t_end - 1e-9 * dt_nominal;
+    commit(st, dt);
+    const std::optional<std::string> criterion = stop_criterion(st);
+    const bool at_end = criterion.has_value() || t_ >= t_end - eps;
     record(at_end);
     if (criterion) {
-      log().info("step {}, t = {:.9g} s: {}", summary.steps, t, *criterion);
-      summary.stop_reason = *criterion;
+      log().info("step {}, t = {:.9g} s: {}", summary_.steps, t_, *criterion);
+      summary_.stop_reason = *criterion;
       break;
     }
-    const auto now = std::chrono::steady_clock::now();
-    const bool stop = opt.stop_after > 0 && summary.steps - steps0 >= opt.stop_after;
-    const bool due_steps =
-        cfg.checkpoint.every_steps > 0 && summary.steps % cfg.checkpoint.every_steps == 0;
-    // Signals and wall-clock deadlines reach the ranks at different times: they act when any
-    // rank has seen them, on every rank in the same step.
-    std::vector<double> flags{
-        static_cast<double>(g_signal),
-        cfg.checkpoint.every_minutes > 0 &&
-                std::chrono::duration<double>(now - last_checkpoint_wall).count() >=
-                    60.0 * cfg.checkpoint.every_minutes
-            ? 1.0
-            : 0.0,
-        !opt.quiet && std::chrono::duration<double>(now - last_progress).count() >=
-                          cfg.output.progress_interval
-            ? 1.0
-            : 0.0};
-    if (comm.size() > 1) comm.max(flags);
-    const int signal = static_cast<int>(flags[0]);
-    const bool due_wall = flags[1] > 0, due_progress = flags[2] > 0;
-    if ((signal != 0 || stop) && !at_end) {
-      summary.signal = signal;
-      summary.interrupted = true;
-      write_checkpoint(signal != 0 ? "signal" : "stop_after");
-      break;
-    }
-    if ((due_steps || due_wall) && !(at_end && cfg.checkpoint.at_end)) {
-      write_checkpoint("periodic");
-      last_checkpoint_wall = now;
-    }
-    if (due_progress) {  // the same step on every rank: the sample is collective
-      last_progress = now;
-      const double wall = std::chrono::duration<double>(now - wall0).count();
-      const auto [sample, state] = progress_sample(st, wall);
-      progress.add(sample);
-      std::optional<double> z;
-      if (settings.contact.enabled)
-        z = observer.coordination(parallel::gather_contacts(comm, solver.contact_problem(), 0));
-      const auto e = progress.estimate();
-      std::string observed;
-      if (state)
-        observed =
-            fmt::format("  Phi = {:.4f}  sigma_top = {:.4g} Pa", state->phi, state->top_stress);
-      if (z) observed += fmt::format("  Z = {:.3f}", *z);
-      const double rate = static_cast<double>(summary.steps - steps0) / std::max(wall, 1e-30);
-      log().info(
-          "step {:>7}  t = {:.6e} s ({:5.1f}% of {} = {:.6g}{}){}  newton {}  {:.1f} steps/s  "
-          "ETA {}",
-          summary.steps, t, 100 * e.fraction, e.criterion, e.target,
-          e.criterion == "end_time"      ? " s"
-          : e.criterion == "stop.stress" ? " Pa"
-                                         : "",
-          observed, st.iterations, rate, format_eta(e.eta));
-    }
+    if (!between_steps(st, at_end)) break;
   }
-  if (!summary.interrupted && cfg.checkpoint.at_end && last_checkpoint_step != summary.steps)
+  return finish();
+}
+
+// The end of the run: its checkpoint, the timers (<name>_timers.csv), the energy balance.
+RunSummary Run::finish() {
+  if (!summary_.interrupted && cfg_.checkpoint.at_end && last_checkpoint_step_ != summary_.steps)
     write_checkpoint("end");
-  summary.time = t;
-  summary.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  summary_.time = t_;
+  summary_.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
   std::string timers;
-  for (const auto& [name, secs] : solver.timers().totals())
+  for (const auto& [name, secs] : solver_->timers().totals())
     timers += fmt::format(" {} {:.2f} s", name, secs);
   // Per-stage timers over ranks with the serial shares (docs/parallel.md): <name>_timers.csv.
-  std::vector<double> bytes{static_cast<double>(comm.bytes_sent())};
-  comm.sum(bytes);
-  const auto solo = comm.solo_report();
-  const auto report = parallel::stage_report(comm, solver.timers().totals());
+  const std::int64_t steps = summary_.steps - steps0_;
+  std::vector<double> bytes{static_cast<double>(comm_.bytes_sent())};
+  comm_.sum(bytes);
+  const auto solo = comm_.solo_report();
+  const auto report = parallel::stage_report(comm_, solver_->timers().totals());
   const std::string csv = parallel::stage_report_csv(
-      report, summary.wall_seconds, comm.size(), omp_get_max_threads(), summary.steps - steps0,
-      bytes[0] / comm.size() / std::max<std::int64_t>(summary.steps - steps0, 1), solo);
-  if (root) {
+      report, summary_.wall_seconds, comm_.size(), omp_get_max_threads(), steps,
+      bytes[0] / comm_.size() / std::max<std::int64_t>(steps, 1), solo);
+  if (root_) {
     io::write_file_atomic(
-        (fs::path(summary.output_dir) / (cfg.simulation.name + "_timers.csv")).string(), csv);
-    log().info("{} rank(s), scheme {}: timers in {}_timers.csv", comm.size(),
-               parallel::to_string(scheme), cfg.simulation.name);
+        (fs::path(summary_.output_dir) / (cfg_.simulation.name + "_timers.csv")).string(), csv);
+    log().info("{} rank(s), scheme {}: timers in {}_timers.csv", comm_.size(),
+               parallel::to_string(scheme_), cfg_.simulation.name);
   }
-  if (summary.interrupted) {
+  if (summary_.interrupted) {
     log().warn("stopped ({}) at step {} (t = {:.9g} s)",
-               summary.signal != 0 ? signal_name(summary.signal) : "--stop-after", summary.steps,
-               t);
-    return summary;
+               summary_.signal != 0 ? signal_name(summary_.signal) : "--stop-after", summary_.steps,
+               t_);
+    return summary_;
   }
-  if (!wall_work.empty() && comm.size() > 1) gather_state(0);  // collective
-  if (!wall_work.empty() && root) {  // the energy balance of the run (docs/accuracy.md)
-    const Ledger l = ledger(mpm::diagnostics(model));
-    const double in = l.walls + body_work;
-    const auto pct = [&](double x) { return in != 0 ? 100 * x / std::abs(in) : 0.0; };
-    log().info(
-        "energy: walls and body forces did {:.6g} J/m of work, elastic + kinetic changed by "
-        "{:.6g} J/m; dissipated by contact {:.3g} %, by the transfers {:.3g} %, in the bulk "
-        "(stress work not stored) {:.3g} %; unaccounted {:.3g} % of the work",
-        in, l.change, pct(contact_dissipation), pct(transfer_dissipation), pct(l.internal),
-        pct(l.rest));
-    // The ledger closes to the solver tolerances (about 1e-8 of the work): a remainder above
-    // kLedgerTolerance of the energy scale is work from outside it (docs/accuracy.md).
-    constexpr double kLedgerTolerance = 1e-3;
-    const double scale = std::max({std::abs(in), std::abs(l.change), 1e-300});
-    if (std::abs(l.rest) > kLedgerTolerance * scale)
-      log().warn(
-          "the energy ledger does not close: {:.6g} J/m ({:.3g} % of the work) is unaccounted; "
-          "prescribed grid velocities ([[boundary]]) do work the ledger does not count, and loose "
-          "Newton or Gauss-Seidel tolerances leave a remainder (docs/accuracy.md)",
-          l.rest, 100 * std::abs(l.rest) / scale);
+  if (ledger_.active()) {                  // the energy balance of the run (docs/accuracy.md)
+    if (comm_.size() > 1) gather_state();  // collective
+    if (root_) ledger_.report(mpm::diagnostics(model_));
   }
-  log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary.steps,
-             summary.failed_steps, t, summary.wall_seconds, timers);
-  log().info("outputs in {}", summary.output_dir);
-  return summary;
+  log().info("done: {} steps ({} retried) to t = {:.6g} s in {:.2f} s wall;{}", summary_.steps,
+             summary_.failed_steps, t_, summary_.wall_seconds, timers);
+  log().info("outputs in {}", summary_.output_dir);
+  return summary_;
+}
+
+}  // namespace detail
+
+RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
+                          const checkpoint::State* restart) {
+  return detail::Run(cfg, opt, restart).go();
 }
 
 }  // namespace mpmcd::app

@@ -41,35 +41,6 @@ struct RunSummary {
   int signal = 0;                      ///< signal that interrupted the run (0: none)
 };
 
-/// A checkpoint and the input of the run it continues.
-struct Restart {
-  io::Config config;        ///< the validated input
-  checkpoint::State state;  ///< the state to continue from
-  std::string path;         ///< the checkpoint file
-};
-
-/// Reads checkpoint `path` (refused with InputError if damaged) and the input it continues:
-/// `input` if not empty (its text must be the one the checkpoint was written from), else the input
-/// text stored in the checkpoint. Throws InputError (exit 2).
-Restart load_restart(const std::string& path, const std::string& input);
-
-/// Builds the 2D model (grid, materials, seeded grains, initial velocities) from the input;
-/// throws InputError for inputs that pass the schema but cannot be built (e.g. a grain too small
-/// to hold one material point).
-mpm::Model<2> build_model(const io::Config& config);
-
-/// Node sets and prescribed velocities of the [[boundary]] tables at time t [s] (moving boxes are
-/// translated by velocity * t).
-std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& config,
-                                                 const grid::Grid<2>& grid, double t);
-
-/// Solver settings from the input.
-mpm::Settings<2> build_settings(const io::Config& config);
-
-/// Throws InputError if a material point starts outside a wall (walls must enclose the grains).
-void check_walls_enclose(const io::Config& config, const mpm::Model<2>& model,
-                         const mpm::Settings<2>& settings);
-
 /// Runs the whole simulation, from t = 0 or from `restart` (options.restart names its file);
 /// throws InputError (exit 2) or NumericalError (exit 3, after writing the last good state and
 /// its checkpoint). SIGINT/SIGTERM finish the current step, write a checkpoint and return with

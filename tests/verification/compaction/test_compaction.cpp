@@ -16,7 +16,7 @@
 #include "mpmcd/analysis/compaction_fit.hpp"
 #include "mpmcd/analysis/time_series.hpp"
 #include "mpmcd/app/compaction_observer.hpp"
-#include "mpmcd/app/simulation.hpp"
+#include "mpmcd/app/model_builder.hpp"
 #include "mpmcd/io/load_config.hpp"
 
 #include "../../support/cli_runner.hpp"

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "mpmcd/app/model_builder.hpp"
 #include "mpmcd/app/progress.hpp"
-#include "mpmcd/app/simulation.hpp"
 #include "mpmcd/app/speed_check.hpp"
 #include "mpmcd/io/load_config.hpp"
 

@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/simulation.hpp"
 #include "mpmcd/checkpoint/checkpoint.hpp"
 #include "mpmcd/core/errors.hpp"

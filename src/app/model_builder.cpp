@@ -1,0 +1,328 @@
+#include "mpmcd/app/model_builder.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include "mpmcd/core/errors.hpp"
+#include "mpmcd/core/log.hpp"
+#include "mpmcd/packing/input.hpp"
+#include "mpmcd/packing/overlap.hpp"
+#include "mpmcd/packing/packing.hpp"
+#include "mpmcd/packing/seeding.hpp"
+#include "mpmcd/points/seeding.hpp"
+
+namespace mpmcd::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+Vec<2> vec2(const std::vector<double>& v) {
+  return Vec<2>(v.at(0), v.at(1));
+}
+
+// v(x) = velocity + gradient (x - c) + omega e_z x (x - c) + A sin(k . x + phase) (InitialVelocity)
+Vec<2> initial_velocity(const io::InitialVelocity& iv, const Vec<2>& c, const Vec<2>& x) {
+  Vec<2> v = Vec<2>::Zero();
+  if (iv.velocity.size() == 2) v += vec2(iv.velocity);
+  if (iv.gradient.size() == 4) {
+    Mat<2> L;
+    L << iv.gradient[0], iv.gradient[1], iv.gradient[2], iv.gradient[3];
+    v += L * (x - c);
+  }
+  const Vec<2> r = x - c;
+  v += iv.angular_velocity * Vec<2>(-r[1], r[0]);
+  if (iv.sine_amplitude.size() == 2 && iv.sine_wavevector.size() == 2)
+    v += vec2(iv.sine_amplitude) * std::sin(vec2(iv.sine_wavevector).dot(x) + iv.sine_phase);
+  return v;
+}
+
+// Every disk of a packing file becomes a grain (points from packing::seed_packing, which gives a
+// lattice site shared by two overlapping disks to one of them only).
+// Grain outlines for the overlap check, and what each one is (grain index, packing disk id or -1).
+struct Outlines {
+  std::vector<packing::Outline> shapes;
+  std::vector<std::pair<std::size_t, std::int64_t>> owner;
+};
+
+// Refuses a packing input whose box cannot fit inside the grid (one cell of margin) before the
+// DEM runs (issue 17: 20,000 disks took 18 s to be refused). The box is known when given; else
+// its smallest possible size follows from the smallest disks at the target packing fraction
+// (grow, walls) or at Phi = 1 (jam, whose final Phi is found by the run).
+void check_packing_box(const packing::PackingParams& p, const grid::Grid<2>& grid,
+                       const io::Config& cfg, std::size_t index) {
+  const auto& g = cfg.grains[index];
+  const double h = grid.cell_size();
+  const Vec<2> lo = grid.origin().array() + h, hi = grid.upper().array() - h;
+  Vec<2> b0, b1;
+  if (p.box) {
+    b0 = Vec<2>((*p.box)[0], (*p.box)[1]);
+    b1 = Vec<2>((*p.box)[2], (*p.box)[3]);
+  } else {
+    double area = 0;  // smallest possible disk area [m^2]
+    if (!p.diameters.empty())
+      for (const double d : p.diameters) area += std::numbers::pi * 0.25 * d * d;
+    else
+      area =
+          static_cast<double>(p.count) * std::numbers::pi * 0.25 * p.diameter_min * p.diameter_min;
+    const double phi = p.method == packing::PackingMethod::kJam ? 1.0 : p.target_phi;
+    b0 = Vec<2>(p.origin[0], p.origin[1]);
+    b1 =
+        b0 + Vec<2>(std::sqrt(area / phi * p.aspect_ratio), std::sqrt(area / phi / p.aspect_ratio));
+  }
+  if ((b0.array() < lo.array()).any() || (b1.array() > hi.array()).any())
+    throw InputError(g.file, 0, "packing",
+                     fmt::format("the packing box [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] m{} must lie "
+                                 "inside the grid with one cell of margin, [{:.6g}, {:.6g}] x "
+                                 "[{:.6g}, {:.6g}] m (grains[{}], {}:{}); checked before the DEM "
+                                 "runs",
+                                 b0[0], b1[0], b0[1], b1[1], p.box ? "" : " (at least)", lo[0],
+                                 hi[0], lo[1], hi[1], index, cfg.source_path, g.line));
+}
+
+void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t index,
+                        int material, Outlines& outlines) {
+  const auto& g = cfg.grains[index];
+  packing::Packing pk;
+  if (fs::path(g.file).extension() == ".toml") {  // a packing input: generate it now (seeded DEM)
+    const auto input = packing::load_packing_input(g.file);
+    check_packing_box(input.params, model.grid, cfg, index);
+    pk = packing::generate_packing(input.params);
+    log().info("generated from {}: {}", g.file, packing::summary_line(pk));
+  } else {
+    pk = packing::read_packing_csv(g.file);
+  }
+  const double h = model.grid.cell_size();
+  const Vec<2> lo = model.grid.origin().array() + h, hi = model.grid.upper().array() - h;
+  for (const auto& d : pk.disks) {
+    const Vec<2> c(d.x, d.y);
+    if (((c.array() - d.radius) < lo.array()).any() || ((c.array() + d.radius) > hi.array()).any())
+      throw InputError(g.file, 0, fmt::format("disk {}", d.id),
+                       fmt::format("the disk (center {:.6g} {:.6g} m, radius {:.6g} m) must lie "
+                                   "inside the grid with one cell of margin (grains[{}], {}:{})",
+                                   d.x, d.y, d.radius, index, cfg.source_path, g.line));
+    outlines.shapes.push_back({d.x, d.y, 0.0, 0.0, d.radius});
+    outlines.owner.emplace_back(index, d.id);
+  }
+  if (g.seeding == "polar") {  // each disk on its own rings, strictly inside its circle
+    const double s = h / g.points_per_cell;
+    double estimate = 0;
+    for (const auto& d : pk.disks) estimate += std::numbers::pi * d.radius * d.radius / (s * s);
+    if (estimate > 2e8)
+      throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].points_per_cell", index),
+                       fmt::format("the packing would need about {:.3g} material points (at most "
+                                   "2e8): coarsen the grid or lower points_per_cell",
+                                   estimate));
+    for (const auto& d : pk.disks) {
+      const Vec<2> c(d.x, d.y);
+      model.add_grain(points::seed_disk_polar(c, d.radius, h / g.points_per_cell), material,
+                      0.5 * h / g.points_per_cell,
+                      [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
+    }
+    return;
+  }
+  const auto seeded = packing::seed_packing(pk, model.grid.origin(), h, g.points_per_cell);
+  for (std::size_t k = 0; k < pk.disks.size(); ++k) {
+    points::Seeds<2> seeds;
+    seeds.x.assign(seeded.x.begin() + seeded.offset[k], seeded.x.begin() + seeded.offset[k + 1]);
+    seeds.volume.assign(seeded.volume.begin() + seeded.offset[k],
+                        seeded.volume.begin() + seeded.offset[k + 1]);
+    const Vec<2> c(pk.disks[k].x, pk.disks[k].y);
+    model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
+                    [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
+  }
+}
+
+// Grains may touch but not overlap (docs/robustness.md): their common area would be counted twice
+// in the volume and Phi. Names both grains (a packing's disk by its id) and the overlap.
+void check_no_overlap(const io::Config& cfg, const Outlines& outlines) {
+  const auto o = packing::find_overlap(outlines.shapes, packing::kOverlapTolerance);
+  if (!o) return;
+  const auto describe = [&](std::size_t k) {
+    const auto [i, id] = outlines.owner[k];
+    const auto& g = cfg.grains[i];
+    return id >= 0 ? fmt::format("disk id {} of {} (grains[{}], line {})", id, g.file, i, g.line)
+                   : fmt::format("grains[{}] (line {})", i, g.line);
+  };
+  const std::size_t later = outlines.owner[o->second].first;
+  throw InputError(
+      cfg.source_path, cfg.grains[later].line, fmt::format("grains[{}]", later),
+      fmt::format("grains that touch but do not overlap (up to {:g} of the smaller one's "
+                  "diameter or side): {} overlaps {} by {:.6g} m = {:.3g} of the smaller size "
+                  "(their common area would be counted twice in the volume and Phi)",
+                  packing::kOverlapTolerance, describe(o->second), describe(o->first), o->depth,
+                  o->depth / o->size));
+}
+
+}  // namespace
+
+template <int Dim>
+mpm::Model<Dim> model_frame(const io::Config& cfg) {
+  mpm::Model<Dim> model;
+  const double h = cfg.grid.cell_size;
+  Vec<Dim> origin;
+  IVec<Dim> cells;
+  for (int d = 0; d < Dim; ++d) {
+    origin[d] = cfg.grid.origin.at(d);
+    cells[d] = static_cast<std::int64_t>(std::llround(cfg.grid.extent[d] / h));
+  }
+  model.grid = grid::Grid<Dim>(origin, h, cells);
+  for (const auto& m : cfg.materials) {
+    try {
+      model.add_material(materials::make_law<Dim>(m.law, m.params), m.density);
+    } catch (const InputError& e) {
+      throw InputError(cfg.source_path, m.line, "materials." + e.key(), e.what());
+    }
+  }
+  return model;
+}
+
+template mpm::Model<2> model_frame<2>(const io::Config&);
+
+mpm::Model<2> build_model(const io::Config& cfg) {
+  mpm::Model<2> model = model_frame<2>(cfg);
+  const double h = cfg.grid.cell_size;
+  Outlines outlines;
+  for (std::size_t i = 0; i < cfg.grains.size(); ++i) {
+    const auto& g = cfg.grains[i];
+    int material = -1;
+    for (std::size_t k = 0; k < cfg.materials.size(); ++k)
+      if (cfg.materials[k].name == g.material) material = static_cast<int>(k);
+    points::Seeds<2> seeds;
+    Vec<2> center;
+    if (g.shape == "disk") {
+      center = vec2(g.center);
+      outlines.shapes.push_back({center[0], center[1], 0.0, 0.0, g.radius});
+      seeds =
+          g.seeding == "polar"
+              ? points::seed_disk_polar(center, g.radius, h / g.points_per_cell)
+              : points::seed_ball<2>(model.grid.origin(), h, g.points_per_cell, center, g.radius);
+    } else if (g.shape == "rectangle") {
+      const Vec<2> lo = vec2(g.min_corner), hi = vec2(g.max_corner);
+      center = 0.5 * (lo + hi);
+      outlines.shapes.push_back({lo[0], lo[1], hi[0], hi[1], 0.0});
+      seeds = points::seed_box<2>(model.grid.origin(), h, g.points_per_cell, lo, hi);
+    } else if (g.shape == "packing") {
+      add_packing_grains(model, cfg, i, material, outlines);
+      continue;
+    } else {
+      throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].shape", i),
+                       "unknown shape \"" + g.shape + "\"");
+    }
+    outlines.owner.emplace_back(i, -1);
+    if (seeds.x.empty())
+      throw InputError(cfg.source_path, g.line, fmt::format("grains[{}]", i),
+                       "the grain is too small to hold a material point at this cell size and "
+                       "points_per_cell: refine the grid or raise points_per_cell");
+    model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
+                    [&](const Vec<2>& x) { return initial_velocity(g.initial, center, x); });
+  }
+  check_no_overlap(cfg, outlines);
+  return model;
+}
+
+std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& cfg, const grid::Grid<2>& grid,
+                                                 double t) {
+  std::vector<mpm::VelocityBC<2>> out;
+  const auto& n = grid.nodes_per_axis();
+  const double h = grid.cell_size();
+  for (const auto& b : cfg.boundaries) {
+    mpm::VelocityBC<2> bc;
+    for (const auto& f : b.fix) bc.mask |= static_cast<std::uint8_t>(1u << (f == "x" ? 0 : 1));
+    bc.velocity = vec2(b.velocity);
+    IVec<2> lo = IVec<2>::Zero(), hi = n - IVec<2>::Ones();
+    if (b.nodes == "xmin") hi[0] = 0;
+    if (b.nodes == "xmax") lo[0] = n[0] - 1;
+    if (b.nodes == "ymin") hi[1] = 0;
+    if (b.nodes == "ymax") lo[1] = n[1] - 1;
+    if (b.nodes == "box") {
+      const Vec<2> shift = b.moving ? Vec<2>(t * bc.velocity) : Vec<2>::Zero();
+      for (int d = 0; d < 2; ++d) {
+        const double a = (b.box_min[d] + shift[d] - grid.origin()[d]) / h;
+        const double z = (b.box_max[d] + shift[d] - grid.origin()[d]) / h;
+        lo[d] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a - 1e-9)));
+        hi[d] = std::min<std::int64_t>(n[d] - 1, static_cast<std::int64_t>(std::floor(z + 1e-9)));
+      }
+    }
+    for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+      for (std::int64_t i = lo[0]; i <= hi[0]; ++i) bc.nodes.push_back(grid.node_index({i, j}));
+    out.push_back(std::move(bc));
+  }
+  return out;
+}
+
+mpm::Settings<2> build_settings(const io::Config& cfg) {
+  mpm::Settings<2> s;
+  s.shape = grid::shape_kind_from_string(cfg.grid.shape_function);
+  s.theta = cfg.time.theta;
+  s.max_iterations = cfg.solver.max_iterations;
+  s.residual_tolerance = cfg.solver.residual_tolerance;
+  s.increment_tolerance = cfg.solver.increment_tolerance;
+  s.linear_solver = mpm::linear_solver_from_string(cfg.solver.linear_solver);
+  s.cg_tolerance = cfg.solver.cg_tolerance;
+  s.cg_max_iterations = cfg.solver.cg_max_iterations;
+  s.flip = cfg.solver.flip;
+  s.affine = cfg.solver.affine;
+  s.modified_newton = cfg.solver.modified_newton;
+  if (cfg.loads.gravity.size() == 2) s.gravity = vec2(cfg.loads.gravity);
+  // Contact: enabled when asked and there is something to touch (two grains or a wall).
+  auto& c = s.contact;
+  std::size_t grains = 0;
+  for (const auto& g : cfg.grains) grains += g.shape == "packing" ? 2 : 1;
+  c.enabled = cfg.contact.enabled && (grains > 1 || !cfg.walls.empty());
+  c.criterion =
+      cfg.contact.criterion == "overlap" ? mpm::GapCriterion::kOverlap : mpm::GapCriterion::kGap;
+  c.mass_fraction = cfg.contact.mass_fraction;
+  c.gs.tolerance = cfg.contact.tolerance;
+  c.gs.max_sweeps = cfg.contact.max_sweeps;
+  c.gs.relaxation = cfg.contact.relaxation;
+  c.gs.relax_after = cfg.contact.relax_after;
+  c.gs.node_blocks = cfg.contact.node_blocks;
+  c.impulse_tolerance = cfg.contact.impulse_tolerance;
+  c.wall_range = cfg.contact.wall_range;
+  c.wall_points = cfg.contact.wall_contact == "points";
+  // Delassus operator: the lumped 1/m_I is accurate when inertia dominates a step (theta c_p dt/h
+  // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered
+  // contact-Newton loop converging in a few iterations.
+  double cp = 0;
+  for (const auto& m : cfg.materials)
+    cp = std::max(cp, std::sqrt((m.params.at("lambda") + 2 * m.params.at("mu")) / m.density));
+  const double courant = cfg.time.theta * cp * cfg.time.dt / cfg.grid.cell_size;
+  c.grain_compliance =
+      cfg.contact.delassus == "grain" || (cfg.contact.delassus == "auto" && courant > 0.1);
+  const auto nm = static_cast<int>(cfg.materials.size());
+  c.materials = nm;
+  c.friction.assign(static_cast<std::size_t>(nm * nm), cfg.contact.friction);
+  auto index = [&](const std::string& name) {
+    for (int k = 0; k < nm; ++k)
+      if (cfg.materials[k].name == name) return k;
+    return 0;
+  };
+  for (const auto& p : cfg.contact.pairs) {
+    const int a = index(p.materials[0]), b = index(p.materials[1]);
+    c.friction[a * nm + b] = c.friction[b * nm + a] = p.friction;
+  }
+  for (const auto& w : cfg.walls)
+    c.walls.push_back({w.name, vec2(w.point), vec2(w.normal), vec2(w.velocity), w.friction});
+  return s;
+}
+
+void check_walls_enclose(const io::Config& cfg, const mpm::Model<2>& model,
+                         const mpm::Settings<2>& settings) {
+  for (std::size_t k = 0; k < settings.contact.walls.size(); ++k) {
+    const auto& wall = settings.contact.walls[k];
+    for (std::size_t p = 0; p < model.points.size(); ++p)
+      if (wall.distance(model.points.x[p], 0.0) < 0.0)
+        throw InputError(cfg.source_path, cfg.walls[k].line, fmt::format("walls[{}]", k),
+                         fmt::format("wall \"{}\" does not enclose the grains: grain {} has a "
+                                     "material point at ({:.6g}, {:.6g}) m on its outer side",
+                                     wall.name, model.points.grain[p], model.points.x[p][0],
+                                     model.points.x[p][1]));
+  }
+}
+
+}  // namespace mpmcd::app
