@@ -50,22 +50,19 @@ CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Mode
   vs0_ = reference_grain_area(model);
   grains_ = static_cast<std::int64_t>(model.grains.size());
   contact_ = config.contact.enabled && (grains_ > 1 || !config.walls.empty());
-  // M_p = λ + 2μ of the grains' material: defined when every material used by a grain has the
-  // same λ and μ (docs/observables.md).
+  // M_p of the grains' material, as its law answers it (λ + 2μ for the laws of λ and μ): defined
+  // when the materials of all grains have the same M_p and K_p, i.e. the same λ and μ for those
+  // laws (docs/observables.md).
   std::set<std::pair<double, double>> moduli;
-  bool all = true;
-  for (const auto& g : config.grains)
-    for (const auto& m : config.materials)
-      if (m.name == g.material) {
-        const auto l = m.params.find("lambda"), u = m.params.find("mu");
-        if (l == m.params.end() || u == m.params.end())
-          all = false;
-        else
-          moduli.insert({l->second, u->second});
-      }
-  if (all && moduli.size() == 1) mp_ = moduli.begin()->first + 2 * moduli.begin()->second;
+  for (const auto& g : model.grains) {
+    const auto& law = *model.laws[static_cast<std::size_t>(g.material)];
+    moduli.insert({law.wave_modulus(), law.bulk_modulus()});
+  }
+  if (moduli.size() == 1) mp_ = moduli.begin()->first;
   if (box_ && !mp_)
-    log().info("sigma_bottom_over_Mp not written: the grains do not share one (lambda, mu)");
+    log().info(
+        "sigma_bottom_over_Mp not written: the grains' materials do not share one P-wave and "
+        "bulk modulus (M_p, K_p)");
   if (!box_ && !config.walls.empty())
     log().info(
         "h, eps, phi and wall stresses not written: the walls do not form a box (four "

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <numbers>
 
+#include "mpmcd/app/speed_check.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/packing/input.hpp"
@@ -255,7 +256,7 @@ std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& cfg, const gr
   return out;
 }
 
-mpm::Settings<2> build_settings(const io::Config& cfg) {
+mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& model) {
   mpm::Settings<2> s;
   s.shape = grid::shape_kind_from_string(cfg.grid.shape_function);
   s.theta = cfg.time.theta;
@@ -289,8 +290,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg) {
   // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered
   // contact-Newton loop converging in a few iterations.
   double cp = 0;
-  for (const auto& m : cfg.materials)
-    cp = std::max(cp, std::sqrt((m.params.at("lambda") + 2 * m.params.at("mu")) / m.density));
+  for (const double c_k : wave_speeds(model)) cp = std::max(cp, c_k);
   const double courant = cfg.time.theta * cp * cfg.time.dt / cfg.grid.cell_size;
   c.grain_compliance =
       cfg.contact.delassus == "grain" || (cfg.contact.delassus == "auto" && courant > 0.1);

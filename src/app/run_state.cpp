@@ -222,7 +222,7 @@ Restart load_restart(const std::string& path, const std::string& input) {
 RestoredRun restore_from_checkpoint(const std::string& path, const std::string& input) {
   Restart r = load_restart(path, input);
   mpm::Model<2> model = restore_model<2>(r.config, r.state, path);
-  mpm::Settings<2> settings = build_settings(r.config);
+  mpm::Settings<2> settings = build_settings(r.config, model);
   std::vector<mpm::WarmImpulse<2>> warm = warm_start_of<2>(r.state);
   return RestoredRun{std::move(r.config), std::move(r.state), std::move(model),
                      std::move(settings), std::move(warm),    path};

@@ -56,7 +56,7 @@ mpm::Model<2> initial_model(const io::Config& cfg, const RunOptions& opt,
 
 // The solver settings; a new run's walls must enclose its grains.
 mpm::Settings<2> checked_settings(const io::Config& cfg, const mpm::Model<2>& model, bool restart) {
-  auto settings = build_settings(cfg);
+  auto settings = build_settings(cfg, model);
   if (!restart) check_walls_enclose(cfg, model, settings);
   return settings;
 }

@@ -72,7 +72,8 @@ class CompactionObserver {
   /// True when the walls form a box (h, ε, Φ and the stresses are measured).
   bool has_box() const { return box_.has_value(); }
 
-  /// The grains' P-wave modulus M_p = λ + 2μ [Pa], or nullopt if not unique (docs/observables.md).
+  /// The grains' P-wave modulus M_p (Law::wave_modulus, λ + 2μ) [Pa], or nullopt if the grains'
+  /// materials differ in M_p or K_p (docs/observables.md).
   std::optional<double> p_wave_modulus() const { return mp_; }
 
  private:

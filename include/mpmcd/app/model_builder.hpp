@@ -28,8 +28,9 @@ mpm::Model<2> build_model(const io::Config& config);
 std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& config,
                                                  const grid::Grid<2>& grid, double t);
 
-/// Solver settings from the input.
-mpm::Settings<2> build_settings(const io::Config& config);
+/// Solver settings from the input and its model (its materials' wave speeds decide the Delassus
+/// operator).
+mpm::Settings<2> build_settings(const io::Config& config, const mpm::Model<2>& model);
 
 /// Throws InputError if a material point starts outside a wall (walls must enclose the grains).
 void check_walls_enclose(const io::Config& config, const mpm::Model<2>& model,

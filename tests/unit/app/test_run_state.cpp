@@ -62,8 +62,9 @@ std::vector<mpmcd::mpm::WarmImpulse<2>> some_warm_start() {
   return {{5, 0, 1, Vec<2>(1.5, -2.5)}, {-3, -2, 0, Vec<2>(0.25, 0.125)}};
 }
 
-std::vector<mpmcd::mpm::Wall<2>> walls_of(const mpmcd::io::Config& cfg) {
-  return app::build_settings(cfg).contact.walls;
+std::vector<mpmcd::mpm::Wall<2>> walls_of(const mpmcd::io::Config& cfg,
+                                          const mpmcd::mpm::Model<2>& model) {
+  return app::build_settings(cfg, model).contact.walls;
 }
 
 // The checkpoint of `model` at t = 2.46e-3 s.
@@ -77,7 +78,7 @@ mpmcd::checkpoint::State checkpoint_of(const mpmcd::io::Config& cfg,
   s.grain_work.assign(model.grains.size() * 4, 0.0);
   app::store_energy(app::EnergyLedger<2>::start(cfg.walls.size(), mpmcd::mpm::diagnostics(model)),
                     s);
-  app::store_run(cfg, model, some_warm_start(), walls_of(cfg), s);
+  app::store_run(cfg, model, some_warm_start(), walls_of(cfg, model), s);
   return s;
 }
 
@@ -99,10 +100,10 @@ TEST(RunState, CheckpointRoundTripIsExact) {
   ASSERT_EQ(back.grains.size(), model.grains.size());
   auto again = s;
   app::store_energy(app::energy_sums_of(s), again);
-  app::store_run(cfg, back, app::warm_start_of<2>(s), walls_of(cfg), again);
+  app::store_run(cfg, back, app::warm_start_of<2>(s), walls_of(cfg, back), again);
   EXPECT_EQ(mpmcd::checkpoint::payload_checksum(again), mpmcd::checkpoint::payload_checksum(s));
   back.points.F[3](0, 1) = std::nextafter(back.points.F[3](0, 1), 2.0);  // one bit off: seen
-  app::store_run(cfg, back, app::warm_start_of<2>(s), walls_of(cfg), again);
+  app::store_run(cfg, back, app::warm_start_of<2>(s), walls_of(cfg, back), again);
   EXPECT_NE(mpmcd::checkpoint::payload_checksum(again), mpmcd::checkpoint::payload_checksum(s));
 
   const auto warm = app::warm_start_of<2>(s);
