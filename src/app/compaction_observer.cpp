@@ -5,6 +5,7 @@
 #include <cmath>
 #include <set>
 
+#include "mpmcd/app/model_builder.hpp"
 #include "mpmcd/core/log.hpp"
 
 namespace mpmcd::app {
@@ -49,7 +50,7 @@ CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Mode
   if (box_) box0_ = analysis::box_at(walls_, *box_, 0.0);
   vs0_ = reference_grain_area(model);
   grains_ = static_cast<std::int64_t>(model.grains.size());
-  contact_ = config.contact.enabled && (grains_ > 1 || !config.walls.empty());
+  contact_ = contact_enabled(config, model.grains.size());
   // M_p of the grains' material, as its law answers it (λ + 2μ for the laws of λ and μ): defined
   // when the materials of all grains have the same M_p and K_p, i.e. the same λ and μ for those
   // laws (docs/observables.md).

@@ -256,6 +256,10 @@ std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& cfg, const gr
   return out;
 }
 
+bool contact_enabled(const io::Config& cfg, std::size_t grains) {
+  return cfg.contact.enabled && (grains > 1 || !cfg.walls.empty());
+}
+
 mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& model) {
   mpm::Settings<2> s;
   s.shape = grid::shape_kind_from_string(cfg.grid.shape_function);
@@ -270,11 +274,8 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
   s.affine = cfg.solver.affine;
   s.modified_newton = cfg.solver.modified_newton;
   if (cfg.loads.gravity.size() == 2) s.gravity = vec2(cfg.loads.gravity);
-  // Contact: enabled when asked and there is something to touch (two grains or a wall).
   auto& c = s.contact;
-  std::size_t grains = 0;
-  for (const auto& g : cfg.grains) grains += g.shape == "packing" ? 2 : 1;
-  c.enabled = cfg.contact.enabled && (grains > 1 || !cfg.walls.empty());
+  c.enabled = contact_enabled(cfg, model.grains.size());
   c.criterion =
       cfg.contact.criterion == "overlap" ? mpm::GapCriterion::kOverlap : mpm::GapCriterion::kGap;
   c.mass_fraction = cfg.contact.mass_fraction;

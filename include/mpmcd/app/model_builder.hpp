@@ -3,6 +3,7 @@
 /// (disks, rectangles, packings) with their initial velocities, the [[boundary]] node sets, the
 /// solver settings, and the checks an input can pass only once built (grains inside the grid, no
 /// overlapping grains, walls enclosing the grains).
+#include <cstddef>
 #include <vector>
 
 #include "mpmcd/io/config.hpp"
@@ -28,8 +29,12 @@ mpm::Model<2> build_model(const io::Config& config);
 std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& config,
                                                  const grid::Grid<2>& grid, double t);
 
-/// Solver settings from the input and its model (its materials' wave speeds decide the Delassus
-/// operator).
+/// True when contact is solved: asked for ([contact] enabled) and there is something to touch
+/// (more than one of the model's `grains`, or a wall).
+bool contact_enabled(const io::Config& config, std::size_t grains);
+
+/// Solver settings from the input and its model (the model's grains decide contact_enabled, its
+/// materials' wave speeds the Delassus operator).
 mpm::Settings<2> build_settings(const io::Config& config, const mpm::Model<2>& model);
 
 /// Throws InputError if a material point starts outside a wall (walls must enclose the grains).

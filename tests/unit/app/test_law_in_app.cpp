@@ -1,6 +1,7 @@
 // app/ never names a law's parameters: a run of grains made of a test-only law with parameters of
 // its own (tests/unit/materials/quadratic_volume_law.hpp, registered from here) is built, gets its
-// solver settings and its compaction observables (M_p as the law answers it).
+// solver settings and its compaction observables (M_p as the law answers it). Contact is decided
+// once (app::contact_enabled) for the solver settings and the observables' Z columns.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -73,4 +74,24 @@ TEST(LawInApp, GrainsOfDifferentModuliHaveNoMp) {
   const app::CompactionObserver observer(cfg, app::build_model(cfg));
   EXPECT_FALSE(observer.p_wave_modulus().has_value());
   EXPECT_FALSE(has(observer.csv_header(), "sigma_bottom_over_Mp"));
+}
+
+TEST(LawInApp, ContactIsDecidedOnceForSolverAndObservables) {
+  const std::string wall =
+      "[[walls]]\nname = \"floor\"\npoint = [0.0, 0.0012]\nnormal = [0.0, 1.0]\n";
+  const std::string off = "[contact]\nenabled = false\n";
+  struct Case {
+    mpmcd::io::Config cfg;
+    bool contact;
+  };
+  const Case cases[] = {{config("soft", "", "", 1), false},   // one grain, nothing to touch
+                        {config("soft", wall, "", 1), true},  // one grain and a wall
+                        {config("soft", ""), true},           // two grains
+                        {config("soft", kBox, off), false}};  // not asked
+  for (const auto& c : cases) {
+    const auto model = app::build_model(c.cfg);
+    EXPECT_EQ(app::contact_enabled(c.cfg, model.grains.size()), c.contact);
+    EXPECT_EQ(app::build_settings(c.cfg, model).contact.enabled, c.contact);
+    EXPECT_EQ(has(app::CompactionObserver(c.cfg, model).csv_header(), ",Z,"), c.contact);
+  }
 }
