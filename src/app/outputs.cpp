@@ -79,13 +79,14 @@ void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& pb,
     normal[3 * i + 1] = c.normal[1];
     pn[i] = c.impulse.dot(c.normal);
     pt[i] = c.impulse[1] * c.normal[0] - c.impulse[0] * c.normal[1];  // along t = e_z x n
-    force[3 * i] = c.impulse[0] * inv_dt;
-    force[3 * i + 1] = c.impulse[1] * inv_dt;
+    const Vec<2> f = c.impulse * inv_dt;  // the contact's force on body b [N/m]
+    force[3 * i] = f[0];
+    force[3 * i + 1] = f[1];
     gap[i] = c.gap;
     body_a[i] = c.a >= 0 ? pb.slots[c.a].grain : -1 - c.wall;
     body_b[i] = sb.grain;
     // try_emplace with an explicit zero: Eigen vectors are not zero-initialised.
-    pairs.try_emplace({body_a[i], body_b[i]}, Vec<2>::Zero()).first->second += c.impulse * inv_dt;
+    pairs.try_emplace({body_a[i], body_b[i]}, Vec<2>::Zero()).first->second += f;
   }
   vtu.write(vtu_path);
   std::string text = "body_a,body_b,force_x,force_y\n";
