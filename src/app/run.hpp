@@ -89,6 +89,7 @@ class Run {
   std::int64_t last_checkpoint_step_;
   mpm::StepStats last_;  // the last converged step
   bool fast_points_reported_ = false;
+  bool shrunk_reported_ = false;  // the shrunk-CPDI-domain warning was given
   std::chrono::steady_clock::time_point wall0_, last_progress_, last_checkpoint_wall_;
 };
 

@@ -33,6 +33,14 @@ void Run::record(bool force) {
       log().warn("{}", *w);
       fast_points_reported_ = true;
     }
+  if (root_ && !shrunk_reported_ && last_.shrunk_domains > 0) {
+    log().warn(
+        "{} material point domains span more than two cells along an axis at t = {:.6g} s: CPDI "
+        "evaluates their shape functions on the domain shrunk to fit its window, which no longer "
+        "tiles the grain there (docs/accuracy.md; more points per cell avoid it)",
+        last_.shrunk_domains, t_);
+    shrunk_reported_ = true;
+  }
   ScopedStage ts(&solver_->timers(), "output");
   const auto problem = parallel::gather_contacts(comm_, solver_->contact_problem(), 0);
   if (csv) {

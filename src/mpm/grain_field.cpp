@@ -39,6 +39,7 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   w.factor_in_step = false;
   w.project_tangent = false;
   w.projections = 0;
+  w.shrunk_domains = 0;
   w.z_factor = -1;
   w.pt_first.resize(np);
   w.pt_N.resize(np * K);
@@ -50,13 +51,17 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   Shape ps;
   for (std::int64_t i = 0; i < np; ++i) {
     const std::int64_t p = gr.begin + i;
-    if (!ps.eval(points_.x[p], grid_.origin(), h, gr.half_width,
-                 points_.F[p] * points_.domain[p])) {
-      w.failure =
-          "material point domain spans more than two cells along an axis (stretched over about "
-          "twice its size: seed more points per cell)";
-      w.fail_point = p;
-      return;
+    const Mat<Dim> D = points_.F[p] * points_.domain[p];
+    if (!ps.eval(points_.x[p], grid_.origin(), h, gr.half_width, D)) {
+      // A CPDI domain stretched over more than two cells along an axis: its shape functions use
+      // it shrunk to the window (grid::fit_cpdi_window), counted in StepStats::shrunk_domains.
+      ++w.shrunk_domains;
+      if (!ps.eval(points_.x[p], grid_.origin(), h, gr.half_width,
+                   grid::fit_cpdi_window<Dim>(D, h))) {
+        w.failure = "material point domain does not fit the CPDI window";
+        w.fail_point = p;
+        return;
+      }
     }
     w.pt_first[i] = ps.first;
     for (int a = 0; a < K; ++a) {

@@ -245,6 +245,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.linear_solves += work_[g]->solves;
     stats.factorizations += work_[g]->factorizations;
     stats.projected_factorizations += work_[g]->projections;
+    stats.shrunk_domains += work_[g]->shrunk_domains;
   }
   if (!stats.converged) {
     for (std::size_t g : owned_)
@@ -337,7 +338,8 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   if (dist) {  // sums over the ranks' contacts, added in rank order
     ScopedStage tc(&timers_, "newton.check.comm");
     std::vector<std::int64_t> n{stats.contacts, stats.active_contacts, stats.linear_solves,
-                                stats.factorizations, stats.projected_factorizations};
+                                stats.factorizations, stats.projected_factorizations,
+                                stats.shrunk_domains};
     comm_->sum(n);
     std::vector<std::int64_t> it{-stats.iterations};
     comm_->min(it);
@@ -346,6 +348,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.linear_solves = n[2];
     stats.factorizations = n[3];
     stats.projected_factorizations = n[4];
+    stats.shrunk_domains = n[5];
     stats.iterations = static_cast<int>(-it[0]);
     if (nw > 0) comm_->sum(wall_f);  // one rank holds each grain's wall contacts: exact
   }

@@ -51,6 +51,7 @@ struct ImplicitSolver<Dim>::GrainWork {
   bool factor_in_step = false;            // a factorisation of this step's Newton matrix exists
   bool project_tangent = false;           // this step assembles the projected (PSD) tangent
   std::int64_t projections = 0;           // factorisations redone projected in the current step
+  std::int64_t shrunk_domains = 0;        // points whose CPDI domain was shrunk this step
   std::int64_t factor_count = 0;          // factorisations so far (identifies the current one)
   std::int64_t z_factor = -1;             // the factorisation Z and G were computed with (-1: none)
   double vel_ref = 0;                     // velocity scale of the increment test [sqrt(kg) m/s]

@@ -123,6 +123,17 @@ struct Cpdi1D {
   static constexpr int kNodes = 3;  ///< nodes per axis in the support window
 };
 
+/// The domain D [m] (columns: half-edges) scaled down about the point until its bounding box is
+/// at most one cell h [m] wide along every axis, so that its corners span at most two cells (the
+/// CPDI1 window); D itself when it already fits. The scaled domain still gives a partition of
+/// unity with exact linear fields, but no longer tiles the body with its neighbours.
+template <int Dim>
+Mat<Dim> fit_cpdi_window(const Mat<Dim>& D, double h) {
+  const double half = D.cwiseAbs().rowwise().sum().maxCoeff();  // largest half-extent [m]
+  const double limit = 0.5 * h * (1.0 - 1e-9);
+  return half <= limit ? D : Mat<Dim>(D * (limit / half));
+}
+
 /// CPDI1 weights of one point (Sadeghirad et al. 2011, eqs. 31-32, written for any Dim): the
 /// point's domain is the parallelepiped x_p + D s, s in [-1, 1]^Dim, D = F D0 (columns: current
 /// half-edge vectors [m]); with the linear hat N_I at its 2^Dim corners x_c = x_p + D s_c,

@@ -120,6 +120,9 @@ struct StepStats {
   /// Factorisations redone with the projected tangent because M + theta^2 dt^2 K was indefinite
   /// (docs/accuracy.md, "Indefinite Newton matrices"), summed over grains [-].
   std::int64_t projected_factorizations = 0;
+  /// Points whose CPDI domain spans more than two cells along an axis and whose shape functions
+  /// used it shrunk to fit the window (grid::fit_cpdi_window), summed over grains [-].
+  std::int64_t shrunk_domains = 0;
   /// Work of the contact impulses on the grains over the step, sum_I P_I . (v_I^n + v_I^{n+1}) / 2
   /// over every grain node (the exact kinetic-energy change they cause on the grid) [J] (2D: J/m).
   double contact_work = 0;

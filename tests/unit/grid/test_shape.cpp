@@ -167,3 +167,47 @@ TEST(Shape, CpdiTiledDomainsGiveNoInteriorForceUnderHomogeneousF) {
     EXPECT_GT(interior, 4);
   }
 }
+
+// A CPDI domain stretched over more than two cells along an axis does not fit the 3-node window
+// (eval fails); fit_cpdi_window shrinks it about the point until it does, and the weights of the
+// shrunk domain keep the partition of unity and reproduce linear fields exactly. A domain at most
+// one cell wide is returned unchanged.
+TEST(Shape, CpdiStretchedDomainShrunkToTheWindowStaysConsistent) {
+  const Vec<2> origin(-0.3, 0.1);
+  const double h = 0.25;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(1.0, 3.0), f(-0.4, 0.4), g(1.2, 2.5);
+  int shrunk = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Vec<2> x = origin + h * Vec<2>(u(rng), u(rng));
+    Mat<2> D;  // half-edges stretched to 0.6-1.25 h along one direction, sheared
+    D << g(rng), f(rng), f(rng), 0.5 + f(rng);
+    D *= h / 2;
+    grid::CpdiShape<2> ps;
+    if (ps.eval(x, origin, h, 0.0, D)) continue;  // fits from where it lies
+    ++shrunk;
+    const Mat<2> Dfit = grid::fit_cpdi_window<2>(D, h);
+    EXPECT_LE(Dfit.cwiseAbs().rowwise().sum().maxCoeff(), 0.5 * h);
+    EXPECT_LT((Dfit - D * (Dfit(0, 0) / D(0, 0))).norm(), 1e-15);  // the same shape, scaled
+    ASSERT_TRUE(ps.eval(x, origin, h, 0.0, Dfit));
+    double sum = 0;
+    Vec<2> xr = Vec<2>::Zero();
+    Mat<2> grad = Mat<2>::Zero();
+    for (int a = 0; a < ps.K; ++a) {
+      IVec<2> c = ps.first;
+      for (int d = 0; d < 2; ++d) c[d] += ps.offset(a, d);
+      const Vec<2> xn = origin + h * c.cast<double>();
+      sum += ps.N[a];
+      xr += ps.N[a] * xn;
+      grad += xn * ps.dN[a].transpose();
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-14);
+    EXPECT_LT((xr - x).norm(), 1e-14);
+    EXPECT_LT((grad - Mat<2>::Identity()).norm(), 1e-12);
+  }
+  EXPECT_GT(shrunk, 100);
+  Mat<2> small;
+  small << 0.3, 0.1, -0.05, 0.2;
+  small *= h;  // half-extents 0.4 h and 0.25 h
+  EXPECT_EQ(grid::fit_cpdi_window<2>(small, h), small);
+}
