@@ -337,9 +337,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   }
   if (dist) {  // sums over the ranks' contacts, added in rank order
     ScopedStage tc(&timers_, "newton.check.comm");
-    std::vector<std::int64_t> n{stats.contacts, stats.active_contacts, stats.linear_solves,
-                                stats.factorizations, stats.projected_factorizations,
-                                stats.shrunk_domains};
+    std::vector<std::int64_t> n{
+        stats.contacts,       stats.active_contacts,          stats.linear_solves,
+        stats.factorizations, stats.projected_factorizations, stats.shrunk_domains};
     comm_->sum(n);
     std::vector<std::int64_t> it{-stats.iterations};
     comm_->min(it);

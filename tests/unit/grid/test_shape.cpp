@@ -67,6 +67,26 @@ TEST(Shape, UGimpHalfWidthHalfCell) {
   check_shape<grid::UGimp1D>(0.25 / 2 * 0.999);
 }
 
+// CPDI weights at x: partition of unity and linear reproduction (sum x_I N_I = x_p,
+// sum x_I (x) grad N_I = I).
+static void expect_cpdi_reproduces_linear_fields(const grid::CpdiShape<2>& ps, const Vec<2>& origin,
+                                                 double h, const Vec<2>& x) {
+  double sum = 0;
+  Vec<2> xr = Vec<2>::Zero();
+  Mat<2> grad = Mat<2>::Zero();
+  for (int a = 0; a < ps.K; ++a) {
+    IVec<2> c = ps.first;
+    for (int d = 0; d < 2; ++d) c[d] += ps.offset(a, d);
+    const Vec<2> xn = origin + h * c.cast<double>();
+    sum += ps.N[a];
+    xr += ps.N[a] * xn;
+    grad += xn * ps.dN[a].transpose();
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-14);
+  EXPECT_LT((xr - x).norm(), 1e-14);
+  EXPECT_LT((grad - Mat<2>::Identity()).norm(), 1e-12);
+}
+
 // CPDI1 (Sadeghirad et al. 2011): partition of unity, linear reproduction (sum x_I N_I = x_p,
 // sum x_I (x) grad N_I = I), and the gradient equal to the mean of the exact gradient of the
 // corner interpolant over the parallelogram (midpoint quadrature on a fine sub-grid of it).
@@ -82,20 +102,7 @@ TEST(Shape, CpdiPartitionOfUnityLinearReproductionAndMeanGradient) {
     D *= h / 4;
     grid::CpdiShape<2> ps;
     ASSERT_TRUE(ps.eval(x, origin, h, 0.0, D));
-    double sum = 0;
-    Vec<2> xr = Vec<2>::Zero();
-    Mat<2> grad = Mat<2>::Zero();
-    for (int a = 0; a < ps.K; ++a) {
-      IVec<2> c = ps.first;
-      for (int d = 0; d < 2; ++d) c[d] += ps.offset(a, d);
-      const Vec<2> xn = origin + h * c.cast<double>();
-      sum += ps.N[a];
-      xr += ps.N[a] * xn;
-      grad += xn * ps.dN[a].transpose();
-    }
-    EXPECT_NEAR(sum, 1.0, 1e-14);
-    EXPECT_LT((xr - x).norm(), 1e-14);
-    EXPECT_LT((grad - Mat<2>::Identity()).norm(), 1e-12);
+    expect_cpdi_reproduces_linear_fields(ps, origin, h, x);
     // Mean gradient of the bilinear corner interpolant of N_I over the domain, node by node.
     const int m = 40;
     for (int a = 0; a < ps.K; ++a) {
@@ -190,20 +197,7 @@ TEST(Shape, CpdiStretchedDomainShrunkToTheWindowStaysConsistent) {
     EXPECT_LE(Dfit.cwiseAbs().rowwise().sum().maxCoeff(), 0.5 * h);
     EXPECT_LT((Dfit - D * (Dfit(0, 0) / D(0, 0))).norm(), 1e-15);  // the same shape, scaled
     ASSERT_TRUE(ps.eval(x, origin, h, 0.0, Dfit));
-    double sum = 0;
-    Vec<2> xr = Vec<2>::Zero();
-    Mat<2> grad = Mat<2>::Zero();
-    for (int a = 0; a < ps.K; ++a) {
-      IVec<2> c = ps.first;
-      for (int d = 0; d < 2; ++d) c[d] += ps.offset(a, d);
-      const Vec<2> xn = origin + h * c.cast<double>();
-      sum += ps.N[a];
-      xr += ps.N[a] * xn;
-      grad += xn * ps.dN[a].transpose();
-    }
-    EXPECT_NEAR(sum, 1.0, 1e-14);
-    EXPECT_LT((xr - x).norm(), 1e-14);
-    EXPECT_LT((grad - Mat<2>::Identity()).norm(), 1e-12);
+    expect_cpdi_reproduces_linear_fields(ps, origin, h, x);
   }
   EXPECT_GT(shrunk, 100);
   Mat<2> small;
