@@ -6,23 +6,27 @@
 # stop, VTU snapshots off and one checkpoint kept (the one written at the stop), and links that
 # checkpoint as build/compaction_checkpoints/lambda3_<grid>.h5 for the benchmark.
 # Usage (from anywhere, after the release build):
-#   tools/compaction_checkpoints.sh [-t THREADS] [-p PHI] d4 [d8]
-# THREADS defaults to 2. The run's log is lambda3_<grid>/run.log. Measured with 2 threads on the
+#   tools/compaction_checkpoints.sh [-t THREADS] [-p PHI] [-r] d4 [d8]
+# THREADS defaults to 2. A run stopped by SIGINT/SIGTERM (Ctrl-C) writes a checkpoint; -r resumes
+# the latest checkpoint in lambda3_<grid>/output (mpmcd run --restart) instead of starting anew. The run's log is lambda3_<grid>/run.log. Measured with 2 threads on the
 # shared 2-core machine: d4 about 5 min; d8 about an hour (issue 16).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 mpmcd="${MPMCD:-$root/build/release/mpmcd}"
 threads=2
 phi=0.90
-while getopts "t:p:" o; do
+resume=0
+usage="usage: $0 [-t THREADS] [-p PHI] [-r] d4|d8 ..."
+while getopts "t:p:r" o; do
   case "$o" in
     t) threads="$OPTARG" ;;
     p) phi="$OPTARG" ;;
-    *) echo "usage: $0 [-t THREADS] [-p PHI] d4|d8 ..." >&2; exit 2 ;;
+    r) resume=1 ;;
+    *) echo "$usage" >&2; exit 2 ;;
   esac
 done
 shift $((OPTIND - 1))
-[ $# -gt 0 ] || { echo "usage: $0 [-t THREADS] [-p PHI] d4|d8 ..." >&2; exit 2; }
+[ $# -gt 0 ] || { echo "$usage" >&2; exit 2; }
 [ -x "$mpmcd" ] || { echo "$mpmcd not found: build first (cmake --build --preset release)" >&2; exit 2; }
 examples="$root/examples/paper_compaction"
 out_root="$root/build/compaction_checkpoints"
@@ -33,18 +37,26 @@ for grid in "$@"; do
     *) echo "unknown grid '$grid' (d4 or d8)" >&2; exit 2 ;;
   esac
   dir="$out_root/lambda3_$grid"
-  mkdir -p "$dir"
-  cp "$examples/packing.csv" "$dir/"
-  # The same input but where it stops, where it writes, no VTU and one checkpoint kept.
-  sed -e "s/^phi = .*/phi = $phi/" -e 's/^folder = .*/folder = "output"\nvtu = false/' "$input" \
-    > "$dir/input.toml"
-  printf '\n[checkpoint]\nkeep = 1\n' >> "$dir/input.toml"
-  grep -q "^phi = $phi\$" "$dir/input.toml" || { echo "no [stop] phi in $input" >&2; exit 1; }
-  echo "compaction_checkpoints: $grid to phi = $phi on $threads thread(s), log in $dir/run.log"
+  latest() { ls "$dir"/output/*_checkpoint_*.h5 2> /dev/null | sort | tail -n 1; }
+  if [ "$resume" = 1 ] && [ -n "$(latest)" ]; then
+    echo "compaction_checkpoints: $grid resumed from $(latest), log appended to $dir/run.log"
+    run=(run --restart "$(latest)" -t "$threads")
+  else
+    mkdir -p "$dir"
+    cp "$examples/packing.csv" "$dir/"
+    # The same input but where it stops, where it writes, no VTU and one checkpoint kept.
+    sed -e "s/^phi = .*/phi = $phi/" -e 's/^folder = .*/folder = "output"\nvtu = false/' "$input" \
+      > "$dir/input.toml"
+    printf '\n[checkpoint]\nkeep = 1\n' >> "$dir/input.toml"
+    grep -q "^phi = $phi\$" "$dir/input.toml" || { echo "no [stop] phi in $input" >&2; exit 1; }
+    echo "compaction_checkpoints: $grid to phi = $phi on $threads thread(s), log in $dir/run.log"
+    : > "$dir/run.log"
+    run=(run "$dir/input.toml" -t "$threads" --overwrite)
+  fi
   start=$(date +%s)
-  "$mpmcd" run "$dir/input.toml" -t "$threads" --overwrite > "$dir/run.log" 2>&1 ||
-    { echo "mpmcd run failed (exit $?), see $dir/run.log" >&2; exit 1; }
-  checkpoint=$(ls "$dir"/output/*_checkpoint_*.h5 | sort | tail -n 1)
+  "$mpmcd" "${run[@]}" >> "$dir/run.log" 2>&1 ||
+    { echo "mpmcd run stopped (exit $?; 4: interrupted, resume with -r), see $dir/run.log" >&2; exit 1; }
+  checkpoint=$(latest)
   ln -sfn "lambda3_$grid/output/$(basename "$checkpoint")" "$out_root/lambda3_$grid.h5"
   echo "compaction_checkpoints: $out_root/lambda3_$grid.h5 -> $checkpoint" \
     "($(($(date +%s) - start)) s; $(grep -o 'Phi = [0-9.]*' "$dir/run.log" | tail -n 1))"
