@@ -7,13 +7,15 @@
 # checkpoint as build/compaction_checkpoints/lambda3_<grid>.h5 for the benchmark.
 # Usage (from anywhere, after the release build):
 #   tools/compaction_checkpoints.sh [-t THREADS] [-p PHI] [-r] d4 [d8]
-# THREADS defaults to 2. A run stopped by SIGINT/SIGTERM (Ctrl-C) writes a checkpoint; -r resumes
-# the latest checkpoint in lambda3_<grid>/output (mpmcd run --restart) instead of starting anew. The run's log is lambda3_<grid>/run.log. Measured with 2 threads on the
-# shared 2-core machine: d4 about 5 min; d8 about an hour (issue 16).
+# THREADS defaults to 1: on a machine shared with other jobs, 2 threads with libgomp's default
+# wait policy are up to 20x slower than 1 in the dense state (docs/parallel.md, "Dense-state
+# benchmark"). A run stopped by SIGINT/SIGTERM (Ctrl-C) writes a checkpoint; -r resumes the latest
+# checkpoint in lambda3_<grid>/output (mpmcd run --restart) instead of starting anew. The run's
+# log is lambda3_<grid>/run.log. MPMCD names another mpmcd binary.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 mpmcd="${MPMCD:-$root/build/release/mpmcd}"
-threads=2
+threads=1
 phi=0.90
 resume=0
 usage="usage: $0 [-t THREADS] [-p PHI] [-r] d4|d8 ..."
