@@ -9,6 +9,27 @@
 
 using namespace mpmcd;
 
+// Weights of any shape family at x: partition of unity and linear reproduction
+// (sum x_I N_I = x_p, sum x_I (x) grad N_I = I to grad_tol).
+template <class Shape>
+void expect_reproduces_linear_fields(const Shape& ps, const Vec<2>& origin, double h,
+                                     const Vec<2>& x, double grad_tol) {
+  double sum = 0;
+  Vec<2> xr = Vec<2>::Zero();
+  Mat<2> grad = Mat<2>::Zero();
+  for (int a = 0; a < ps.K; ++a) {
+    IVec<2> c = ps.first;
+    for (int d = 0; d < 2; ++d) c[d] += ps.offset(a, d);
+    const Vec<2> xn = origin + h * c.cast<double>();
+    sum += ps.N[a];
+    xr += ps.N[a] * xn;
+    grad += xn * ps.dN[a].transpose();
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-14);
+  EXPECT_LT((xr - x).norm(), 1e-14);
+  EXPECT_LT((grad - Mat<2>::Identity()).norm(), grad_tol);
+}
+
 template <class S1>
 void check_shape(double lp) {
   const Vec<2> origin(-0.3, 0.1);
@@ -19,17 +40,12 @@ void check_shape(double lp) {
     const Vec<2> x = origin + h * Vec<2>(u(rng), u(rng));
     grid::PointShape<2, S1> ps;
     ps.eval(x, origin, h, lp);
-    double sum = 0;
-    Vec<2> xr = Vec<2>::Zero(), gsum = Vec<2>::Zero();
-    Mat<2> grad = Mat<2>::Zero();
+    expect_reproduces_linear_fields(ps, origin, h, x, 1e-13);
+    Vec<2> gsum = Vec<2>::Zero();
     for (int a = 0; a < ps.K; ++a) {
       IVec<2> c = ps.first;
       for (int d = 0; d < 2; ++d) c[d] += ps.offset(a, d);
-      const Vec<2> xn = origin + h * c.cast<double>();
-      sum += ps.N[a];
-      xr += ps.N[a] * xn;
       gsum += ps.dN[a];
-      grad += xn * ps.dN[a].transpose();
       // finite-difference gradient of the same node's weight
       for (int d = 0; d < 2; ++d) {
         Vec<2> xp = x, xm = x;
@@ -50,10 +66,7 @@ void check_shape(double lp) {
         EXPECT_NEAR((weight(sp) - weight(sm)) / (2 * e), ps.dN[a][d], 1e-5 / h);
       }
     }
-    EXPECT_NEAR(sum, 1.0, 1e-14);
-    EXPECT_LT((xr - x).norm(), 1e-14);
     EXPECT_LT(gsum.norm(), 1e-12 / h);
-    EXPECT_LT((grad - Mat<2>::Identity()).norm(), 1e-13);
   }
 }
 
@@ -65,26 +78,6 @@ TEST(Shape, UGimpPartitionOfUnityAndLinearReproduction) {
 }
 TEST(Shape, UGimpHalfWidthHalfCell) {
   check_shape<grid::UGimp1D>(0.25 / 2 * 0.999);
-}
-
-// CPDI weights at x: partition of unity and linear reproduction (sum x_I N_I = x_p,
-// sum x_I (x) grad N_I = I).
-static void expect_cpdi_reproduces_linear_fields(const grid::CpdiShape<2>& ps, const Vec<2>& origin,
-                                                 double h, const Vec<2>& x) {
-  double sum = 0;
-  Vec<2> xr = Vec<2>::Zero();
-  Mat<2> grad = Mat<2>::Zero();
-  for (int a = 0; a < ps.K; ++a) {
-    IVec<2> c = ps.first;
-    for (int d = 0; d < 2; ++d) c[d] += ps.offset(a, d);
-    const Vec<2> xn = origin + h * c.cast<double>();
-    sum += ps.N[a];
-    xr += ps.N[a] * xn;
-    grad += xn * ps.dN[a].transpose();
-  }
-  EXPECT_NEAR(sum, 1.0, 1e-14);
-  EXPECT_LT((xr - x).norm(), 1e-14);
-  EXPECT_LT((grad - Mat<2>::Identity()).norm(), 1e-12);
 }
 
 // CPDI1 (Sadeghirad et al. 2011): partition of unity, linear reproduction (sum x_I N_I = x_p,
@@ -102,7 +95,7 @@ TEST(Shape, CpdiPartitionOfUnityLinearReproductionAndMeanGradient) {
     D *= h / 4;
     grid::CpdiShape<2> ps;
     ASSERT_TRUE(ps.eval(x, origin, h, 0.0, D));
-    expect_cpdi_reproduces_linear_fields(ps, origin, h, x);
+    expect_reproduces_linear_fields(ps, origin, h, x, 1e-12);
     // Mean gradient of the bilinear corner interpolant of N_I over the domain, node by node.
     const int m = 40;
     for (int a = 0; a < ps.K; ++a) {
@@ -197,7 +190,7 @@ TEST(Shape, CpdiStretchedDomainShrunkToTheWindowStaysConsistent) {
     EXPECT_LE(Dfit.cwiseAbs().rowwise().sum().maxCoeff(), 0.5 * h);
     EXPECT_LT((Dfit - D * (Dfit(0, 0) / D(0, 0))).norm(), 1e-15);  // the same shape, scaled
     ASSERT_TRUE(ps.eval(x, origin, h, 0.0, Dfit));
-    expect_cpdi_reproduces_linear_fields(ps, origin, h, x);
+    expect_reproduces_linear_fields(ps, origin, h, x, 1e-12);
   }
   EXPECT_GT(shrunk, 100);
   Mat<2> small;
