@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <map>
+#include <numbers>
 #include <utility>
 
 namespace mpmcd::analysis {
@@ -72,6 +75,106 @@ Mat<2> love_weber_stress(const points::PointSet<2>& points, double area) {
   Mat<2> sum = Mat<2>::Zero();
   for (std::size_t p = 0; p < points.size(); ++p) sum += points.sigma[p] * points.volume[p];
   return sum / area;  // σ̄ = (1/V) Σ_p σ_p V_p (docs/observables.md)
+}
+
+Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, double pixel,
+                         std::int64_t max_pixels) {
+  const std::size_t n = points.size();
+  // The domains' edges F D (columns) and the raster's extent: the box and every domain.
+  std::vector<Mat<2>> edges(n);
+  Vec<2> lo(box.x_min, box.y_min), hi(box.x_max, box.y_max);
+  for (std::size_t p = 0; p < n; ++p) {
+    edges[p] = points.F[p] * points.domain[p];
+    const Vec<2> half = edges[p].cwiseAbs().rowwise().sum();  // half the bounding box
+    lo = lo.cwiseMin(points.x[p] - half);
+    hi = hi.cwiseMax(points.x[p] + half);
+  }
+  const Vec<2> extent = hi - lo;
+  pixel = std::max(pixel, std::sqrt(extent.prod() / static_cast<double>(max_pixels)));
+  std::int64_t nx = 0, ny = 0;
+  for (;; pixel *= 1.01) {  // the raster over the extent, at most max_pixels
+    nx = static_cast<std::int64_t>(std::ceil(extent[0] / pixel)) + 1;
+    ny = static_cast<std::int64_t>(std::ceil(extent[1] / pixel)) + 1;
+    if (nx * ny <= max_pixels) break;
+  }
+  std::vector<std::int32_t> last(static_cast<std::size_t>(nx * ny), -1);  // last grain seen
+  std::vector<std::uint16_t> grains(last.size(), 0);                    // grains covering
+  for (std::size_t p = 0; p < n; ++p) {
+    const Mat<2>& e = edges[p];
+    const double det = e.determinant();
+    if (!(std::fabs(det) > 0)) continue;
+    const Mat<2> inv = e.inverse();
+    const Vec<2> half = e.cwiseAbs().rowwise().sum();
+    const Vec<2> a = (points.x[p] - half - lo) / pixel, b = (points.x[p] + half - lo) / pixel;
+    // pixel i covers [lo + i pixel, lo + (i + 1) pixel): its centre lo + (i + 1/2) pixel
+    const auto i0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a[0] - 0.5)));
+    const auto i1 = std::min<std::int64_t>(nx - 1, static_cast<std::int64_t>(std::floor(b[0] - 0.5)));
+    const auto j0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a[1] - 0.5)));
+    const auto j1 = std::min<std::int64_t>(ny - 1, static_cast<std::int64_t>(std::floor(b[1] - 0.5)));
+    const std::int32_t g = points.grain[p];
+    for (std::int64_t j = j0; j <= j1; ++j)
+      for (std::int64_t i = i0; i <= i1; ++i) {
+        const Vec<2> c = lo + pixel * Vec<2>(static_cast<double>(i) + 0.5,
+                                             static_cast<double>(j) + 0.5);
+        const Vec<2> s = inv * (c - points.x[p]);  // c = x_p + F D s
+        if (std::fabs(s[0]) > 1.0 || std::fabs(s[1]) > 1.0) continue;
+        const auto k = static_cast<std::size_t>(j * nx + i);
+        if (last[k] == g) continue;
+        last[k] = g;
+        if (grains[k] < std::numeric_limits<std::uint16_t>::max()) ++grains[k];
+      }
+  }
+  Coverage out;
+  out.pixel = pixel;
+  const double area = pixel * pixel;
+  std::int64_t inside = 0, beyond = 0, extra = 0;
+  for (std::int64_t j = 0; j < ny; ++j)
+    for (std::int64_t i = 0; i < nx; ++i) {
+      const auto count = grains[static_cast<std::size_t>(j * nx + i)];
+      if (count == 0) continue;
+      extra += count - 1;
+      const Vec<2> c = lo + pixel * Vec<2>(static_cast<double>(i) + 0.5,
+                                           static_cast<double>(j) + 0.5);
+      const bool in = c[0] >= box.x_min && c[0] < box.x_max && c[1] >= box.y_min &&
+                      c[1] < box.y_max;
+      ++(in ? inside : beyond);
+    }
+  // Pores: the 4-connected components of uncovered pixels inside the box (flood fill).
+  const auto in_box = [&](std::int64_t i, std::int64_t j) {
+    const Vec<2> c =
+        lo + pixel * Vec<2>(static_cast<double>(i) + 0.5, static_cast<double>(j) + 0.5);
+    return c[0] >= box.x_min && c[0] < box.x_max && c[1] >= box.y_min && c[1] < box.y_max;
+  };
+  double weighted = 0, void_area = 0;
+  std::vector<std::int64_t> stack;
+  for (std::int64_t start = 0; start < nx * ny; ++start) {
+    if (grains[static_cast<std::size_t>(start)] != 0 || !in_box(start % nx, start / nx)) continue;
+    std::int64_t pixels = 0;
+    grains[static_cast<std::size_t>(start)] = 1;  // visited: marked as covered
+    stack.push_back(start);
+    while (!stack.empty()) {
+      const std::int64_t k = stack.back();
+      stack.pop_back();
+      ++pixels;
+      const std::int64_t i = k % nx, j = k / nx;
+      const std::int64_t next[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+      for (const auto& [a, b] : next) {
+        if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
+        const auto q = static_cast<std::size_t>(b * nx + a);
+        if (grains[q] != 0 || !in_box(a, b)) continue;
+        grains[q] = 1;
+        stack.push_back(b * nx + a);
+      }
+    }
+    const double a = static_cast<double>(pixels) * area;
+    weighted += a * std::sqrt(4 * a / std::numbers::pi);
+    void_area += a;
+  }
+  out.pore_diameter = void_area > 0 ? weighted / void_area : 0.0;
+  out.covered = static_cast<double>(inside) * area;
+  out.outside = static_cast<double>(beyond) * area;
+  out.overlap = static_cast<double>(extra) * area;
+  return out;
 }
 
 std::vector<ContactImpulse> contact_impulses(const contact::Problem<2>& problem) {

@@ -50,6 +50,7 @@ CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Mode
   if (box_) box0_ = analysis::box_at(walls_, *box_, 0.0);
   vs0_ = reference_grain_area(model);
   grains_ = static_cast<std::int64_t>(model.grains.size());
+  pixel_ = model.grid.cell_size() / 16;
   contact_ = contact_enabled(config, model.grains.size());
   // M_p of the grains' material, as its law answers it (λ + 2μ for the laws of λ and μ): defined
   // when the materials of all grains have the same M_p and K_p, i.e. the same λ and μ for those
@@ -76,7 +77,7 @@ std::string CompactionObserver::csv_header() const {
     h += ",h,width,box_area,eps,phi,Vs,ln_Vs_Vs0";
     for (const auto& w : config_.walls) h += ",wall_" + w.name + "_stress";
     if (mp_) h += ",sigma_bottom_over_Mp";
-    h += ",lw_sxx,lw_syy,lw_sxy";
+    h += ",lw_sxx,lw_syy,lw_sxy,phi_covered,overlap_over_Vs,outside_over_Vs,pore_diameter";
   }  // without a box: Vs is the `volume` column already
   if (contact_) h += ",Z,Z_pairs,Z_grains,rattlers";
   return h;
@@ -101,6 +102,9 @@ std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm
     if (mp_) out += fmt::format(",{:.12e}", bottom / *mp_);
     const Mat<2> lw = analysis::love_weber_stress(model.points, box.area());
     out += fmt::format(",{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1), lw(0, 1));
+    const auto c = analysis::domain_coverage(model.points, box, pixel_);
+    out += fmt::format(",{:.8e},{:.8e},{:.8e},{:.8e}", c.covered / box.area(), c.overlap / vs,
+                       c.outside / vs, c.pore_diameter);
   }
   if (contact_) {
     const auto z = analysis::coordination(analysis::contact_impulses(problem), grains_);

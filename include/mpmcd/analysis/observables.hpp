@@ -75,6 +75,25 @@ double wall_normal_stress(const Vec<2>& force_on_wall, const Vec<2>& normal, dou
 /// σ̄ = (1/V) Σ_p σ_p V_p with V_p the points' current volume (docs/observables.md) [Pa].
 Mat<2> love_weber_stress(const points::PointSet<2>& points, double area);
 
+/// How the point domains cover the box (docs/observables.md, "Coverage"): each point's domain is
+/// the parallelogram x_p + F_p D_p s, s ∈ [-1, 1]² (D_p its reference half-edge vectors, the
+/// CPDI domain), rasterised on square pixels whose centres are tested.
+struct Coverage {
+  double covered = 0;  ///< area inside the box covered by at least one domain [m^2]
+  double overlap = 0;  ///< area covered by two or more grains, counted (grains − 1) times [m^2]
+  double outside = 0;  ///< area outside the box covered by at least one domain [m^2]
+  /// Pore size: mean equivalent diameter sqrt(4 A_i / π) of the connected void regions inside
+  /// the box (4-connected uncovered pixels), weighted by their areas A_i [m]; 0 without void.
+  double pore_diameter = 0;
+  double pixel = 0;    ///< side of the pixels used [m]
+};
+
+/// The coverage of the box by the point domains, on pixels of side `pixel` [m] (enlarged so that
+/// the raster over the box and the domains holds at most `max_pixels` pixels). Points of a grain
+/// must be contiguous (points::PointSet); overlaps of domains of one grain are not counted.
+Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, double pixel,
+                         std::int64_t max_pixels = std::int64_t{1} << 24);
+
 /// One grid-node contact reduced to what Z needs.
 struct ContactImpulse {
   std::int32_t a = -1;        ///< grain A, or -1 - k for wall k [-]

@@ -1,6 +1,7 @@
 #pragma once
 /// The compaction observables of a run (docs/observables.md): extra CSV columns (box height, ε, Φ,
-/// Vs, ln(Vs/Vs0), wall stresses, σ/M_p of the bottom wall, Love-Weber stress, coordination Z)
+/// Vs, ln(Vs/Vs0), wall stresses, σ/M_p of the bottom wall, Love-Weber stress, coverage of the
+/// box by the point domains, coordination Z)
 /// and the [stop] criteria. Wires analysis/ to the model and the solver; used by run_simulation.
 #include <optional>
 #include <string>
@@ -85,6 +86,7 @@ class CompactionObserver {
   std::optional<double> mp_;
   bool contact_ = false;
   std::int64_t grains_ = 0;
+  double pixel_ = 0;  ///< pixel of the coverage raster, h/16 [m]
 };
 
 }  // namespace mpmcd::app

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <vector>
 
 #include "mpmcd/analysis/observables.hpp"
@@ -207,4 +208,80 @@ TEST(TimeSeries, ReadsColumnsAndRefusesGarbage) {
   std::ofstream(bad) << "time,phi\n0\n";
   EXPECT_THROW(read_time_series(bad), InputError);
   EXPECT_THROW(read_time_series((dir / "none.csv").string()), InputError);
+}
+
+namespace {
+
+// A grain: an nx x ny lattice of square point domains of side d with lower-left corner `origin`,
+// every point with the deformation gradient F about the grain's centre.
+void add_block(points::PointSet<2>& pts, std::int32_t g, const Vec<2>& origin, int nx, int ny,
+               double d, const Mat<2>& F = Mat<2>::Identity()) {
+  const Vec<2> centre = origin + 0.5 * d * Vec<2>(nx, ny);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Vec<2> x0 = origin + d * Vec<2>(i + 0.5, j + 0.5);
+      pts.add(centre + F * (x0 - centre), Vec<2>::Zero(), 1.0, d * d,
+              Mat<2>::Identity() * (0.5 * d), g);
+      pts.F.back() = F;
+    }
+}
+
+}  // namespace
+
+TEST(Coverage, OneGrainCoversItsAreaAndTwoOverlappingGrainsTheirStrip) {
+  const Box box{0, 4e-3, 0, 2e-3};
+  const double d = 1e-4;
+  points::PointSet<2> pts;
+  add_block(pts, 0, Vec<2>(0.5e-3, 0.5e-3), 10, 10, d);  // 1 mm x 1 mm
+  const double pixel = d / 16;
+  const auto one = domain_coverage(pts, box, pixel);
+  EXPECT_DOUBLE_EQ(one.pixel, pixel);
+  EXPECT_NEAR(one.covered, 1e-6, 1e-6 * 4 * pixel / 1e-3);  // one pixel row per edge at most
+  EXPECT_EQ(one.overlap, 0.0);
+  EXPECT_EQ(one.outside, 0.0);
+
+  // A second grain overlapping the first over a 0.23 mm strip and crossing the right wall.
+  add_block(pts, 1, Vec<2>(1.27e-3, 0.5e-3), 30, 10, d);  // x from 1.27 to 4.27 mm
+  const auto two = domain_coverage(pts, box, pixel);
+  EXPECT_NEAR(two.overlap, 0.23e-3 * 1e-3, 2 * pixel * 1e-3);
+  EXPECT_NEAR(two.outside, 0.27e-3 * 1e-3, 2 * pixel * 1e-3);
+  EXPECT_NEAR(two.covered, (4e-3 - 0.5e-3) * 1e-3,  // the union inside the box
+              4 * pixel * 1e-3);
+}
+
+TEST(Coverage, DomainsFollowTheDeformationGradient) {
+  const Box box{0, 4e-3, 0, 4e-3};
+  Mat<2> F;
+  F << 1.3, 0.4, -0.1, 0.6;  // J = 0.82
+  points::PointSet<2> pts;
+  add_block(pts, 0, Vec<2>(1.5e-3, 1.5e-3), 10, 10, 1e-4, F);
+  const auto c = domain_coverage(pts, box, 1e-4 / 16);
+  EXPECT_NEAR(c.covered / 1e-6, F.determinant(), 0.01);  // tiles without gaps or overlaps
+  EXPECT_EQ(c.overlap, 0.0);  // overlaps within a grain are not counted
+  // A raster limited to 1e4 pixels coarsens them and still measures the area.
+  const auto coarse = domain_coverage(pts, box, 1e-4 / 16, 10000);
+  EXPECT_GT(coarse.pixel, 4e-3 / 100);  // 100 x 100 pixels cover at most the 4 mm box
+  EXPECT_NEAR(coarse.covered / 1e-6, F.determinant(), 0.05);
+}
+
+TEST(Coverage, PoreDiameterIsTheAreaWeightedEquivalentDiameterOfTheVoids) {
+  // A 1 mm x 1 mm box filled by one grain except a square hole of 0.2 mm and a 0.1 mm hole:
+  // d = (A1 d1 + A2 d2) / (A1 + A2) with d_i = sqrt(4 A_i / π).
+  const Box box{0, 1e-3, 0, 1e-3};
+  const double d = 1e-4;
+  points::PointSet<2> pts;
+  for (int j = 0; j < 10; ++j)
+    for (int i = 0; i < 10; ++i) {
+      if ((i == 2 || i == 3) && (j == 2 || j == 3)) continue;  // 0.2 mm hole
+      if (i == 7 && j == 7) continue;                          // 0.1 mm hole
+      pts.add(Vec<2>((i + 0.5) * d, (j + 0.5) * d), Vec<2>::Zero(), 1.0, d * d,
+              Mat<2>::Identity() * (0.5 * d), 0);
+    }
+  const auto c = domain_coverage(pts, box, d / 16);
+  const double a1 = 4e-8, a2 = 1e-8;
+  const double expected =
+      (a1 * std::sqrt(4 * a1 / std::numbers::pi) + a2 * std::sqrt(4 * a2 / std::numbers::pi)) /
+      (a1 + a2);
+  EXPECT_NEAR(c.pore_diameter, expected, 1e-3 * expected);
+  EXPECT_NEAR(c.covered, 1e-6 - a1 - a2, 1e-12);
 }
