@@ -139,18 +139,23 @@ Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, doub
                       c[1] < box.y_max;
       ++(in ? inside : beyond);
     }
-  // Pores: the 4-connected components of uncovered pixels inside the box (flood fill).
+  // Voids: the 4-connected components of uncovered pixels inside the box (flood fill, visited
+  // pixels marked last = -2). A void bordered by one grain only and not by a wall is a gap inside
+  // that grain (slivers of the seeding's tiling); the others are pores.
   const auto in_box = [&](std::int64_t i, std::int64_t j) {
     const Vec<2> c =
         lo + pixel * Vec<2>(static_cast<double>(i) + 0.5, static_cast<double>(j) + 0.5);
     return c[0] >= box.x_min && c[0] < box.x_max && c[1] >= box.y_min && c[1] < box.y_max;
   };
-  double weighted = 0, void_area = 0;
+  double weighted = 0, pore_area = 0, gap_area = 0;
   std::vector<std::int64_t> stack;
   for (std::int64_t start = 0; start < nx * ny; ++start) {
-    if (grains[static_cast<std::size_t>(start)] != 0 || !in_box(start % nx, start / nx)) continue;
+    const auto s0 = static_cast<std::size_t>(start);
+    if (grains[s0] != 0 || last[s0] == -2 || !in_box(start % nx, start / nx)) continue;
     std::int64_t pixels = 0;
-    grains[static_cast<std::size_t>(start)] = 1;  // visited: marked as covered
+    std::int32_t first = -1;  // a grain bordering the void
+    bool pore = false;        // bordered by two grains or by a wall
+    last[s0] = -2;
     stack.push_back(start);
     while (!stack.empty()) {
       const std::int64_t k = stack.back();
@@ -159,18 +164,32 @@ Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, doub
       const std::int64_t i = k % nx, j = k / nx;
       const std::int64_t next[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
       for (const auto& [a, b] : next) {
-        if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
+        if (a < 0 || b < 0 || a >= nx || b >= ny || !in_box(a, b)) {
+          pore = true;  // the void reaches a wall
+          continue;
+        }
         const auto q = static_cast<std::size_t>(b * nx + a);
-        if (grains[q] != 0 || !in_box(a, b)) continue;
-        grains[q] = 1;
+        if (grains[q] != 0) {  // covered: last[q] is one of its grains
+          if (first < 0) first = last[q];
+          pore = pore || last[q] != first;
+          continue;
+        }
+        if (last[q] == -2) continue;
+        last[q] = -2;
         stack.push_back(b * nx + a);
       }
     }
     const double a = static_cast<double>(pixels) * area;
+    if (!pore) {
+      gap_area += a;
+      continue;
+    }
     weighted += a * std::sqrt(4 * a / std::numbers::pi);
-    void_area += a;
+    pore_area += a;
   }
-  out.pore_diameter = void_area > 0 ? weighted / void_area : 0.0;
+  out.pore_diameter = pore_area > 0 ? weighted / pore_area : 0.0;
+  out.pores = pore_area;
+  out.gaps = gap_area;
   out.covered = static_cast<double>(inside) * area;
   out.outside = static_cast<double>(beyond) * area;
   out.overlap = static_cast<double>(extra) * area;

@@ -77,7 +77,7 @@ std::string CompactionObserver::csv_header() const {
     h += ",h,width,box_area,eps,phi,Vs,ln_Vs_Vs0";
     for (const auto& w : config_.walls) h += ",wall_" + w.name + "_stress";
     if (mp_) h += ",sigma_bottom_over_Mp";
-    h += ",lw_sxx,lw_syy,lw_sxy,phi_covered,overlap_over_Vs,outside_over_Vs,pore_diameter";
+    h += ",lw_sxx,lw_syy,lw_sxy,phi_geometric,overlap_over_Vs,outside_over_Vs,pore_diameter";
   }  // without a box: Vs is the `volume` column already
   if (contact_) h += ",Z,Z_pairs,Z_grains,rattlers";
   return h;
@@ -103,7 +103,7 @@ std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm
     const Mat<2> lw = analysis::love_weber_stress(model.points, box.area());
     out += fmt::format(",{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1), lw(0, 1));
     const auto c = analysis::domain_coverage(model.points, box, pixel_);
-    out += fmt::format(",{:.8e},{:.8e},{:.8e},{:.8e}", c.covered / box.area(), c.overlap / vs,
+    out += fmt::format(",{:.8e},{:.8e},{:.8e},{:.8e}", 1.0 - c.pores / box.area(), c.overlap / vs,
                        c.outside / vs, c.pore_diameter);
   }
   if (contact_) {

@@ -82,8 +82,14 @@ struct Coverage {
   double covered = 0;  ///< area inside the box covered by at least one domain [m^2]
   double overlap = 0;  ///< area covered by two or more grains, counted (grains − 1) times [m^2]
   double outside = 0;  ///< area outside the box covered by at least one domain [m^2]
-  /// Pore size: mean equivalent diameter sqrt(4 A_i / π) of the connected void regions inside
-  /// the box (4-connected uncovered pixels), weighted by their areas A_i [m]; 0 without void.
+  /// Area of the pores: the void regions inside the box (4-connected uncovered pixels) that
+  /// border two grains or a wall [m^2].
+  double pores = 0;
+  /// Area of the void regions bordered by one grain only: gaps of that grain's domain tiling
+  /// (e.g. the slivers between polar seeding's rectangles), solid for Φ [m^2].
+  double gaps = 0;
+  /// Pore size: mean equivalent diameter sqrt(4 A_i / π) of the pores, weighted by their areas
+  /// A_i [m]; 0 without pores.
   double pore_diameter = 0;
   double pixel = 0;    ///< side of the pixels used [m]
 };

@@ -264,24 +264,29 @@ TEST(Coverage, DomainsFollowTheDeformationGradient) {
   EXPECT_NEAR(coarse.covered / 1e-6, F.determinant(), 0.05);
 }
 
-TEST(Coverage, PoreDiameterIsTheAreaWeightedEquivalentDiameterOfTheVoids) {
-  // A 1 mm x 1 mm box filled by one grain except a square hole of 0.2 mm and a 0.1 mm hole:
-  // d = (A1 d1 + A2 d2) / (A1 + A2) with d_i = sqrt(4 A_i / π).
+TEST(Coverage, PoresBorderTwoGrainsOrAWallAndGapsOneGrain) {
+  // A 1 mm x 1 mm box filled by two grains (x < 0.5 mm and x > 0.5 mm) except a 0.2 mm square
+  // hole across both, a 0.1 mm hole on the right wall (pores) and a 0.1 mm hole inside grain 0
+  // (a gap). Pore diameter: (A1 d1 + A2 d2) / (A1 + A2) with d_i = sqrt(4 A_i / π).
   const Box box{0, 1e-3, 0, 1e-3};
   const double d = 1e-4;
   points::PointSet<2> pts;
-  for (int j = 0; j < 10; ++j)
-    for (int i = 0; i < 10; ++i) {
-      if ((i == 2 || i == 3) && (j == 2 || j == 3)) continue;  // 0.2 mm hole
-      if (i == 7 && j == 7) continue;                          // 0.1 mm hole
-      pts.add(Vec<2>((i + 0.5) * d, (j + 0.5) * d), Vec<2>::Zero(), 1.0, d * d,
-              Mat<2>::Identity() * (0.5 * d), 0);
-    }
+  for (int g = 0; g < 2; ++g)
+    for (int j = 0; j < 10; ++j)
+      for (int i = 5 * g; i < 5 * g + 5; ++i) {
+        if ((i == 4 || i == 5) && (j == 2 || j == 3)) continue;  // 0.2 mm pore
+        if (i == 9 && j == 7) continue;                          // 0.1 mm pore on the wall
+        if (i == 1 && j == 7) continue;                          // 0.1 mm gap in grain 0
+        pts.add(Vec<2>((i + 0.5) * d, (j + 0.5) * d), Vec<2>::Zero(), 1.0, d * d,
+                Mat<2>::Identity() * (0.5 * d), g);
+      }
   const auto c = domain_coverage(pts, box, d / 16);
   const double a1 = 4e-8, a2 = 1e-8;
   const double expected =
       (a1 * std::sqrt(4 * a1 / std::numbers::pi) + a2 * std::sqrt(4 * a2 / std::numbers::pi)) /
       (a1 + a2);
   EXPECT_NEAR(c.pore_diameter, expected, 1e-3 * expected);
-  EXPECT_NEAR(c.covered, 1e-6 - a1 - a2, 1e-12);
+  EXPECT_NEAR(c.pores, a1 + a2, 1e-12);
+  EXPECT_NEAR(c.gaps, 1e-8, 1e-12);
+  EXPECT_NEAR(c.covered, 1e-6 - a1 - 2 * a2, 1e-12);
 }
