@@ -98,7 +98,7 @@ Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, doub
     if (nx * ny <= max_pixels) break;
   }
   std::vector<std::int32_t> last(static_cast<std::size_t>(nx * ny), -1);  // last grain seen
-  std::vector<std::uint16_t> grains(last.size(), 0);                    // grains covering
+  std::vector<std::uint16_t> grains(last.size(), 0);                      // grains covering
   for (std::size_t p = 0; p < n; ++p) {
     const Mat<2>& e = edges[p];
     const double det = e.determinant();
@@ -108,14 +108,16 @@ Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, doub
     const Vec<2> a = (points.x[p] - half - lo) / pixel, b = (points.x[p] + half - lo) / pixel;
     // pixel i covers [lo + i pixel, lo + (i + 1) pixel): its centre lo + (i + 1/2) pixel
     const auto i0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a[0] - 0.5)));
-    const auto i1 = std::min<std::int64_t>(nx - 1, static_cast<std::int64_t>(std::floor(b[0] - 0.5)));
+    const auto i1 =
+        std::min<std::int64_t>(nx - 1, static_cast<std::int64_t>(std::floor(b[0] - 0.5)));
     const auto j0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a[1] - 0.5)));
-    const auto j1 = std::min<std::int64_t>(ny - 1, static_cast<std::int64_t>(std::floor(b[1] - 0.5)));
+    const auto j1 =
+        std::min<std::int64_t>(ny - 1, static_cast<std::int64_t>(std::floor(b[1] - 0.5)));
     const std::int32_t g = points.grain[p];
     for (std::int64_t j = j0; j <= j1; ++j)
       for (std::int64_t i = i0; i <= i1; ++i) {
-        const Vec<2> c = lo + pixel * Vec<2>(static_cast<double>(i) + 0.5,
-                                             static_cast<double>(j) + 0.5);
+        const Vec<2> c =
+            lo + pixel * Vec<2>(static_cast<double>(i) + 0.5, static_cast<double>(j) + 0.5);
         const Vec<2> s = inv * (c - points.x[p]);  // c = x_p + F D s
         if (std::fabs(s[0]) > 1.0 || std::fabs(s[1]) > 1.0) continue;
         const auto k = static_cast<std::size_t>(j * nx + i);
@@ -124,6 +126,19 @@ Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, doub
         if (grains[k] < std::numeric_limits<std::uint16_t>::max()) ++grains[k];
       }
   }
+  // Pixels whose centres lo + (i + 1/2) pixel lie in the box: i in [ib[0], ib[1]), j in
+  // [jb[0], jb[1]).
+  const auto first_inside = [&](double edge, double origin, std::int64_t n) {
+    return std::clamp<std::int64_t>(
+        static_cast<std::int64_t>(std::ceil((edge - origin) / pixel - 0.5)), 0, n);
+  };
+  const std::int64_t ib[2] = {first_inside(box.x_min, lo[0], nx),
+                              first_inside(box.x_max, lo[0], nx)};
+  const std::int64_t jb[2] = {first_inside(box.y_min, lo[1], ny),
+                              first_inside(box.y_max, lo[1], ny)};
+  const auto in_box = [&](std::int64_t i, std::int64_t j) {
+    return i >= ib[0] && i < ib[1] && j >= jb[0] && j < jb[1];
+  };
   Coverage out;
   out.pixel = pixel;
   const double area = pixel * pixel;
@@ -133,20 +148,11 @@ Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, doub
       const auto count = grains[static_cast<std::size_t>(j * nx + i)];
       if (count == 0) continue;
       extra += count - 1;
-      const Vec<2> c = lo + pixel * Vec<2>(static_cast<double>(i) + 0.5,
-                                           static_cast<double>(j) + 0.5);
-      const bool in = c[0] >= box.x_min && c[0] < box.x_max && c[1] >= box.y_min &&
-                      c[1] < box.y_max;
-      ++(in ? inside : beyond);
+      ++(in_box(i, j) ? inside : beyond);
     }
   // Voids: the 4-connected components of uncovered pixels inside the box (flood fill, visited
   // pixels marked last = -2). A void bordered by one grain only and not by a wall is a gap inside
   // that grain (slivers of the seeding's tiling); the others are pores.
-  const auto in_box = [&](std::int64_t i, std::int64_t j) {
-    const Vec<2> c =
-        lo + pixel * Vec<2>(static_cast<double>(i) + 0.5, static_cast<double>(j) + 0.5);
-    return c[0] >= box.x_min && c[0] < box.x_max && c[1] >= box.y_min && c[1] < box.y_max;
-  };
   double weighted = 0, pore_area = 0, gap_area = 0;
   std::vector<std::int64_t> stack;
   for (std::int64_t start = 0; start < nx * ny; ++start) {

@@ -50,7 +50,7 @@ CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Mode
   if (box_) box0_ = analysis::box_at(walls_, *box_, 0.0);
   vs0_ = reference_grain_area(model);
   grains_ = static_cast<std::int64_t>(model.grains.size());
-  pixel_ = model.grid.cell_size() / 16;
+  pixel_ = model.grid.cell_size() / 8;
   contact_ = contact_enabled(config, model.grains.size());
   // M_p of the grains' material, as its law answers it (λ + 2μ for the laws of λ and μ): defined
   // when the materials of all grains have the same M_p and K_p, i.e. the same λ and μ for those

@@ -91,7 +91,7 @@ struct Coverage {
   /// Pore size: mean equivalent diameter sqrt(4 A_i / π) of the pores, weighted by their areas
   /// A_i [m]; 0 without pores.
   double pore_diameter = 0;
-  double pixel = 0;    ///< side of the pixels used [m]
+  double pixel = 0;  ///< side of the pixels used [m]
 };
 
 /// The coverage of the box by the point domains, on pixels of side `pixel` [m] (enlarged so that

@@ -86,7 +86,7 @@ class CompactionObserver {
   std::optional<double> mp_;
   bool contact_ = false;
   std::int64_t grains_ = 0;
-  double pixel_ = 0;  ///< pixel of the coverage raster, h/16 [m]
+  double pixel_ = 0;  ///< pixel of the coverage raster, h/8 [m]
 };
 
 }  // namespace mpmcd::app

@@ -257,7 +257,7 @@ TEST(Coverage, DomainsFollowTheDeformationGradient) {
   add_block(pts, 0, Vec<2>(1.5e-3, 1.5e-3), 10, 10, 1e-4, F);
   const auto c = domain_coverage(pts, box, 1e-4 / 16);
   EXPECT_NEAR(c.covered / 1e-6, F.determinant(), 0.01);  // tiles without gaps or overlaps
-  EXPECT_EQ(c.overlap, 0.0);  // overlaps within a grain are not counted
+  EXPECT_EQ(c.overlap, 0.0);                             // overlaps within a grain are not counted
   // A raster limited to 1e4 pixels coarsens them and still measures the area.
   const auto coarse = domain_coverage(pts, box, 1e-4 / 16, 10000);
   EXPECT_GT(coarse.pixel, 4e-3 / 100);  // 100 x 100 pixels cover at most the 4 mm box
