@@ -20,6 +20,7 @@ namespace {
 
 struct BlockResult {
   double worst_J = 0, worst_sigma = 0, force_error = 0, energy_ratio = 0;
+  double worst_sigma11 = 0;   // max |sigma11| / |sigma22 exact| (uniaxial stress: 0) [-]
   double last_step_work = 0;  // final force x wall travel of one step / wall work [-]
   int retries = 0;            // steps redone as two half steps, as the app's step controller does
   std::int64_t factorizations = 0, solves = 0;  // summed over the steps
@@ -31,14 +32,34 @@ struct BlockResult {
   std::string failure;
 };
 
-// Block [0.5, 1.5] mm^2 on a 2 mm grid (h = 0.1 mm, 2x2 points per cell), top wall down at
-// V = 0.4 m/s to s = s_end in `steps` steps (theta = 1).
+// Lateral stretch a of plane-strain uniaxial stress at vertical stretch s: sigma11 = 0, i.e.
+// mu (a^2 - 1) + lambda ln(a s) = 0 (method.md §7 with F = diag(a, s)), by Newton from a = 1.
+double lateral_stretch(double lambda, double mu, double s) {
+  double a = 1.0;
+  for (int k = 0; k < 50; ++k) {
+    const double f = mu * (a * a - 1) + lambda * std::log(a * s), df = 2 * mu * a + lambda / a;
+    a -= f / df;
+    if (std::abs(f) < 1e-15 * (mu + lambda)) break;
+  }
+  return a;
+}
+
+// Block [0.5, 1.5] mm^2 (h = 0.1 mm, 2x2 points per cell), top wall down at V = 0.4 m/s to
+// s = s_end in `steps` steps (theta = 1). With side walls (uniaxial strain) on a 2 mm grid; without
+// (`side_walls` false: uniaxial stress, sides free) on a 4 mm grid with the block centred at
+// x = 2 mm, starting with the lateral velocity of the quasi-static path at s = 1,
+// v_x = λ/(λ + 2μ) V (x - 2 mm)/H0 (the linearised sigma11 = 0).
 BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall_points,
-                    double s_end, int steps, bool modified_newton = false) {
+                    double s_end, int steps, bool modified_newton = false, bool side_walls = true) {
   constexpr double mu = 1.5e6, rho = 990.0, h = 1e-4, lo = 5e-4, hi = 1.5e-3, V = 0.4;
-  auto model = test_support::make_model(h, 20, 20, "neo_hookean", lambda, mu, rho);
-  test_support::add_box(model, Vec<2>(lo, lo), Vec<2>(hi, hi), 2,
-                        [&](const Vec<2>& x) { return Vec<2>(0.0, -V * (x[1] - lo) / (hi - lo)); });
+  const double shift = side_walls ? 0.0 : 1.5e-3;  // x of the block's left edge minus lo [m]
+  const double xc = lo + shift + 0.5 * (hi - lo), rate = lambda / (lambda + 2 * mu) * V / (hi - lo);
+  auto model =
+      test_support::make_model(h, side_walls ? 20 : 40, 20, "neo_hookean", lambda, mu, rho);
+  test_support::add_box(
+      model, Vec<2>(lo + shift, lo), Vec<2>(hi + shift, hi), 2, [&](const Vec<2>& x) {
+        return Vec<2>(side_walls ? 0.0 : rate * (x[0] - xc), -V * (x[1] - lo) / (hi - lo));
+      });
   mpm::Settings<2> s;
   s.shape = shape;
   s.affine = affine;
@@ -53,6 +74,7 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
                      {"top", Vec<2>(0, hi), Vec<2>(0, -1), Vec<2>(0, -V), 0.0},
                      {"left", Vec<2>(lo, 0), Vec<2>(1, 0), Vec<2>::Zero(), 0.0},
                      {"right", Vec<2>(hi, 0), Vec<2>(-1, 0), Vec<2>::Zero(), 0.0}};
+  if (!side_walls) s.contact.walls.resize(2);
   mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
   const double H0 = hi - lo, dt = (1.0 - s_end) * H0 / V / steps;
   const auto d0 = mpm::diagnostics(model);
@@ -89,13 +111,16 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
       return r;
     }
   const double sf = 1.0 - V * t / H0;
-  const double s22 = (mu * (sf * sf - 1) + lambda * std::log(sf)) / sf;
+  const double a = side_walls ? 1.0 : lateral_stretch(lambda, mu, sf), J = a * sf;
+  const double s22 = (mu * (sf * sf - 1) + lambda * std::log(J)) / J;
   for (std::size_t p = 0; p < model.points.size(); ++p) {
-    r.worst_J = std::max(r.worst_J, std::abs(model.points.F[p].determinant() - sf));
+    r.worst_J = std::max(r.worst_J, std::abs(model.points.F[p].determinant() - J));
     r.worst_sigma =
         std::max(r.worst_sigma, std::abs(model.points.sigma[p](1, 1) - s22) / std::abs(s22));
+    r.worst_sigma11 =
+        std::max(r.worst_sigma11, std::abs(model.points.sigma[p](0, 0)) / std::abs(s22));
   }
-  r.force_error = std::abs(force - (-s22 * H0)) / std::abs(s22 * H0);
+  r.force_error = std::abs(force - (-s22 * a * H0)) / std::abs(s22 * a * H0);
   const auto d = mpm::diagnostics(model);
   r.last_step_work = force * V * dt / work;
   r.energy_ratio = (d.elastic + d.kinetic - d0.elastic - d0.kinetic) / work;
@@ -103,7 +128,7 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
   r.transfer_dissipation = transfer / work;
   r.bulk_dissipation = (-stress_work - (d.elastic - d0.elastic)) / work;
   std::printf(
-      "  lambda %.3g MPa, s = %.3f: max |J - s| = %.2e, max rel. sigma22 error = %.2e, "
+      "  lambda %.3g MPa, s = %.3f: max |J - J_exact| = %.2e, max rel. sigma22 error = %.2e, "
       "top force error = %.2e, (elastic + kinetic change) / wall work = %.5f (one step's final "
       "work %.5f), contact "
       "dissipation / wall work = %.2e, transfers %.2e, bulk %.2e, %d steps "
@@ -178,4 +203,28 @@ TEST(WallBlock, ModifiedNewtonKeepsTheExactStateWithFewerFactorisations) {
   // One factorisation per step, and a second where the first was indefinite (projected tangent).
   EXPECT_LE(modified.factorizations, steps + modified.projected + modified.retries * 2);
   EXPECT_LE(2 * modified.factorizations, full.factorizations);
+}
+
+// Open (docs/accuracy.md, "Uniaxial stress"): disabled until the face walls hold it. With
+// lambda = 3 MPa the state is exact to 2.6e-4 (sigma22) after 2 steps and off by 48 % after the
+// third (s = 0.9955), the top-right and bottom-left corners unloading (an antisymmetric mode);
+// lambda = 0 (no lateral motion) is exact to 1e-9. Run it with --gtest_also_run_disabled_tests.
+TEST(WallBlock, DISABLED_UniaxialStressWithFreeSidesKeepsTheExactState) {
+  // Top and bottom walls only: the block widens to a(s), mu (a^2 - 1) + lambda ln(a s) = 0
+  // (a = 1.28 at s = 0.5 for lambda = 3 MPa), its points crossing grid lines sideways while the
+  // top and bottom face contacts change cell columns. Inertia of the lateral motion is below 1e-4
+  // of the stress here (rho a'' L^2 / mu), so the quasi-static closed form holds to the
+  // tolerances below.
+  for (const auto& [lambda, s_end, steps] :
+       {std::tuple{0.0, 0.5, 333}, std::tuple{3e6, 0.5, 333}, std::tuple{1e8, 0.5, 333}}) {
+    const auto r = squeeze(lambda, grid::ShapeKind::kCpdi, true, true, s_end, steps, false, false);
+    ASSERT_TRUE(r.converged) << r.failure;
+    std::printf("  uniaxial stress: max |sigma11| / |sigma22| = %.2e\n", r.worst_sigma11);
+    EXPECT_LT(r.worst_J, 1e-3);
+    EXPECT_LT(r.worst_sigma, 1e-3);
+    EXPECT_LT(r.worst_sigma11, 1e-3);
+    EXPECT_LT(r.force_error, 1e-3);
+    EXPECT_LE(r.energy_ratio, 1.0 + 1e-9);
+    EXPECT_GT(r.energy_ratio, 1.0 - 0.6 * r.last_step_work - 1e-3);
+  }
 }
