@@ -1,7 +1,9 @@
 #pragma once
-/// The validated simulation input as plain data (SI units). Filled by io::load_config
-/// (io/config.cpp) from one TOML file; every key is documented in docs/input.md, generated from the
-/// schema registry.
+/// The validated simulation input as plain data (SI units). Filled by io::load_config from one
+/// TOML file: each key of the schema (io/config.cpp) is bound to the member it fills here, and
+/// every key is documented in docs/input.md, generated from that schema. The initial values below
+/// are the defaults of absent keys, and the schema documents them from here (the defaults that
+/// depend on other keys, e.g. time.dt_min = dt/1024, are set by the reader).
 #include <array>
 #include <cstdint>
 #include <map>
@@ -23,7 +25,7 @@ struct GridSection {
   std::vector<double> origin;             ///< lower corner of the grid [m], Dim entries
   std::vector<double> extent;             ///< size of the grid along each axis [m], Dim entries
   double cell_size = 0.0;                 ///< cell edge length h [m]
-  std::string shape_function = "linear";  ///< "linear" or "ugimp"
+  std::string shape_function = "linear";  ///< "linear", "ugimp" or "cpdi"
 };
 
 /// [[materials]]: a named material, its constitutive law and the law's parameters.
@@ -165,21 +167,21 @@ struct CheckpointSection {
 
 /// The whole validated input.
 struct Config {
-  std::string source_path;  ///< path of the TOML file it came from
-  std::string source_text;  ///< its full text (copied to the output folder)
-  SimulationSection simulation;
-  GridSection grid;
-  std::vector<MaterialSection> materials;
-  std::vector<GrainSection> grains;
-  std::vector<BoundarySection> boundaries;
-  LoadsSection loads;
-  TimeSection time;
-  SolverSection solver;
-  ContactSection contact;
-  std::vector<WallSection> walls;
-  StopSection stop;
-  OutputSection output;
-  CheckpointSection checkpoint;
+  std::string source_path;                  ///< path of the TOML file it came from
+  std::string source_text;                  ///< its full text (copied to the output folder)
+  SimulationSection simulation;             ///< [simulation]: name, dimension, threads
+  GridSection grid;                         ///< [grid]: the background grid
+  std::vector<MaterialSection> materials;   ///< [[materials]], in input order
+  std::vector<GrainSection> grains;         ///< [[grains]], in input order
+  std::vector<BoundarySection> boundaries;  ///< [[boundary]], in input order
+  LoadsSection loads;                       ///< [loads]: body forces
+  TimeSection time;                         ///< [time]: time stepping
+  SolverSection solver;                     ///< [solver]: Newton and linear solver
+  ContactSection contact;                   ///< [contact]: Contact Dynamics
+  std::vector<WallSection> walls;           ///< [[walls]], in input order
+  StopSection stop;                         ///< [stop]: compaction stop criteria
+  OutputSection output;                     ///< [output]: output files
+  CheckpointSection checkpoint;             ///< [checkpoint]: restart files
 };
 
 }  // namespace mpmcd::io

@@ -56,3 +56,20 @@ TEST(InputReference, DocumentsEveryTableKeyAndLaw) {
     }
   }
 }
+
+TEST(InputReference, EveryKeyIsBoundToTheMemberItFills) {
+  // One declaration per key: the schema binds each key to its member of io::Config (only the
+  // law parameters, added per material from the registry, are read by name).
+  const auto& schema = mpmcd::io::config_schema();
+  std::size_t keys = 0;
+  for (const auto& t : schema.tables)
+    for (const auto& k : t.keys) {
+      const std::string path = t.path.empty() ? k.name : t.path + "." + k.name;
+      EXPECT_NE(k.binding, nullptr) << path << " is not bound to a member";
+      ++keys;
+    }
+  EXPECT_GE(keys, 89u);
+  EXPECT_EQ(schema.table("time").find(&mpmcd::io::TimeSection::dt_min)->name, "dt_min");
+  EXPECT_EQ(schema.table("").find(&mpmcd::io::Config::boundaries)->name, "boundary");
+  EXPECT_EQ(schema.table("").find(&mpmcd::io::Config::boundaries)->table, "boundary[]");
+}

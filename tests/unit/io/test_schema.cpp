@@ -116,3 +116,161 @@ TEST(Schema, MarkdownHasOneRowPerKey) {
       << md;
   EXPECT_EQ(mpmcd::io::markdown_cell("a|b\nc"), "a\\|b c");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Keys bound to the members they fill
+
+namespace {
+
+struct Item {
+  std::string label;
+  double weight = 0.5;
+};
+
+struct Box {
+  std::vector<double> size;
+  int count = 3;
+  std::string kind = "hard";
+  std::vector<std::string> tags;
+  bool open = false;
+  std::int64_t serial = 0;
+  Item lid;
+  std::vector<Item> items;
+};
+
+struct Toy {
+  Box box;
+};
+
+Schema bound_schema() {
+  Schema s;
+  s.title = "bound toy";
+  s.tables.push_back(
+      {"", "", "root", {KeySpec::subtable("box", &Toy::box, "a box").require()}, ""});
+  s.add_table(
+      &Toy::box, "a box",
+      {KeySpec::numbers("size", &Box::size, "N", "m", "edge lengths").require(),
+       KeySpec::integer("count", &Box::count, "", "how many").at_least(1).default_of_member(),
+       KeySpec::string("kind", &Box::kind, "what").one_of({"hard", "soft"}).default_of_member(),
+       KeySpec::strings("tags", &Box::tags, "labels").distinct(),
+       KeySpec::boolean("open", &Box::open, "open box").default_of_member(),
+       KeySpec::integer("serial", &Box::serial, "", "serial number").default_of_member(),
+       KeySpec::subtable("lid", &Box::lid, "its lid").defaults("none"),
+       KeySpec::table_array("items", &Box::items, "its content").defaults("none")});
+  s.add_table(&Box::lid, "a lid",
+              {KeySpec::string("label", &Item::label, "name").default_of_member(),
+               KeySpec::number("weight", &Item::weight, "kg", "mass").default_of_member()});
+  s.add_table(&Box::items, "an item",
+              {KeySpec::string("label", &Item::label, "name").require(),
+               KeySpec::number("weight", &Item::weight, "kg", "mass").default_of_member()});
+  return s;
+}
+
+// A binding only compiles with a member of the key's C++ type.
+template <class M>
+concept BindsAsNumber = requires(M m) {
+  KeySpec::number("n", m, "", "");
+};
+template <class M>
+concept BindsAsInteger = requires(M m) {
+  KeySpec::integer("n", m, "", "");
+};
+template <class M>
+concept BindsAsString = requires(M m) {
+  KeySpec::string("n", m, "");
+};
+template <class M>
+concept BindsAsNumbers = requires(M m) {
+  KeySpec::numbers("n", m, "", "", "");
+};
+static_assert(BindsAsNumber<double Item::*>);
+static_assert(!BindsAsNumber<int Box::*>);
+static_assert(!BindsAsNumber<std::string Box::*>);
+static_assert(BindsAsInteger<int Box::*> && BindsAsInteger<std::int64_t Box::*>);
+static_assert(!BindsAsInteger<double Item::*> && !BindsAsInteger<bool Box::*>);
+static_assert(BindsAsString<std::string Box::*> && !BindsAsString<std::vector<std::string> Box::*>);
+static_assert(BindsAsNumbers<std::vector<double> Box::*> && !BindsAsNumbers<double Item::*>);
+
+}  // namespace
+
+TEST(Schema, AddedTablesTakeTheirPathAndHeaderFromTheKey) {
+  const Schema s = bound_schema();
+  ASSERT_EQ(s.tables.size(), 4u);
+  EXPECT_EQ(s.tables[1].path, "box");
+  EXPECT_EQ(s.tables[1].header, "[box]");
+  EXPECT_EQ(s.tables[2].path, "box.lid");
+  EXPECT_EQ(s.tables[2].header, "[box.lid]");
+  EXPECT_EQ(s.tables[3].path, "box.items[]");
+  EXPECT_EQ(s.tables[3].header, "[[box.items]]");
+  EXPECT_EQ(s.table("").find("box")->table, "box");
+  EXPECT_EQ(s.table("box").find("items")->table, "box.items[]");
+  // Documented defaults come from a default-constructed struct.
+  EXPECT_EQ(s.table("box").find("count")->default_text, "3");
+  EXPECT_EQ(s.table("box").find("kind")->default_text, "\"hard\"");
+  EXPECT_EQ(s.table("box").find("open")->default_text, "false");
+  EXPECT_EQ(s.table("box.lid").find("weight")->default_text, "0.5");
+  EXPECT_EQ(s.table("box").find(&Box::kind), s.table("box").find("kind"));
+  EXPECT_EQ(s.table("box").find(&Box::open), s.table("box").find("open"));
+  EXPECT_EQ(s.table("box").find(&Item::weight), nullptr);
+  Schema bad = bound_schema();
+  EXPECT_THROW(bad.add_table(&Item::weight, "not a table", {}), std::logic_error);
+  EXPECT_THROW((void)KeySpec::numbers("v", &Box::size, "", "", "").default_of_member(),
+               std::logic_error);
+}
+
+TEST(Schema, FillAssignsTheBoundMembersThatArePresent) {
+  const Schema s = bound_schema();
+  CheckContext ctx{"toy.toml", {{"N", 2}}};
+  ctx.schema = &s;
+  const toml::table root = toml::parse(
+      std::string_view("[box]\nsize = [1, 2.5]\nkind = \"soft\"\ntags = [\"a\", \"b\"]\nserial = "
+                       "7\n[box.lid]\nlabel = \"top\"\n[[box.items]]\nlabel = \"x\"\nweight = 2\n"
+                       "[[box.items]]\nlabel = \"y\"\n"),
+      std::string_view("toy.toml"));
+  const TableReader r(root, s.table(""), ctx, "", 0);
+  Toy toy;
+  const TableReader box = r.sub(&Toy::box);
+  box.fill(toy.box);
+  EXPECT_EQ(toy.box.size, (std::vector<double>{1.0, 2.5}));
+  EXPECT_EQ(toy.box.count, 3);  // absent: default kept
+  EXPECT_EQ(toy.box.kind, "soft");
+  EXPECT_EQ(toy.box.tags, (std::vector<std::string>{"a", "b"}));
+  EXPECT_FALSE(toy.box.open);
+  EXPECT_EQ(toy.box.serial, 7);
+  box.sub(&Box::lid).fill(toy.box.lid);
+  EXPECT_EQ(toy.box.lid.label, "top");
+  EXPECT_EQ(toy.box.lid.weight, 0.5);
+  const auto tables = box.tables(&Box::items);
+  ASSERT_EQ(tables.size(), 2u);
+  for (std::size_t i = 0; i < tables.size(); ++i) {
+    const TableReader item = box.element(&Box::items, i, *tables[i]);
+    EXPECT_EQ(item.path(), "box.items[" + std::to_string(i) + "]");
+    Item it;
+    item.fill(it);
+    toy.box.items.push_back(it);
+  }
+  EXPECT_EQ(toy.box.items[0].label, "x");
+  EXPECT_EQ(toy.box.items[0].weight, 2.0);
+  EXPECT_EQ(toy.box.items[1].weight, 0.5);
+  // Keys are named by their members.
+  EXPECT_EQ(box.name(&Box::kind), "kind");
+  EXPECT_TRUE(box.has(&Box::kind));
+  EXPECT_FALSE(box.has(&Box::count));
+  EXPECT_EQ(box.line(&Box::kind), 3);
+  EXPECT_EQ(box.line(&Box::count), box.line());
+  try {
+    box.fail(&Box::tags, "expected fewer tags");
+    ADD_FAILURE() << "fail returned";
+  } catch (const mpmcd::InputError& e) {
+    EXPECT_STREQ(e.what(), "toy.toml:4: key 'box.tags': expected fewer tags");
+  }
+  // An absent sub-table reads as an empty one; a member of another struct is a programming error.
+  const toml::table no_lid = toml::parse(std::string_view("[box]\nsize = [1, 2]\n"));
+  const TableReader r2(no_lid, s.table(""), ctx, "", 0);
+  Item lid;
+  r2.sub(&Toy::box).sub(&Box::lid).fill(lid);
+  EXPECT_EQ(lid.label, "");
+  EXPECT_THROW((void)box.name(&Item::label), std::logic_error);
+  Item wrong;
+  EXPECT_THROW(box.fill(wrong), std::logic_error);
+}
