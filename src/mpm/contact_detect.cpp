@@ -38,9 +38,13 @@ template <int Dim>
 std::int32_t ImplicitSolver<Dim>::face_slot(std::int32_t g, const std::vector<std::int64_t>& pts,
                                             const Vec<Dim>& n, Vec<Dim>& x_face) {
   // The point's domain x_p + D s, s in [-1, 1]^Dim, D = F D0; the face toward the wall (normal
-  // n into the domain) is the set of corners minimising s . D^T n. Its velocity is the mean of
-  // the corners' velocities interpolated with the linear hat (the same corner kinematics as
-  // CPDI): weights w_I = mean over the face corners of N_I(x_c).
+  // n into the domain) is the face s_k = -sign(m_k . n) whose normal m_k = D^-T e_k is the most
+  // nearly parallel to n: all 2^(Dim-1) corners of that face, whatever the domain's small shear
+  // or rotation (choosing the corners that minimise s . D^T n instead switches from a face to a
+  // single corner, and so changes the constraint's nodes and weights, as soon as round-off
+  // shears the domain: docs/accuracy.md, "Uniaxial stress"). Its velocity is the mean of the
+  // corners' velocities interpolated with the linear hat (the same corner kinematics as CPDI):
+  // weights w_I = mean over the face corners of N_I(x_c).
   const GrainWork& w = *work_[g];
   const double h = grid_.cell_size();
   std::vector<std::int32_t> nodes;
@@ -50,13 +54,19 @@ std::int32_t ImplicitSolver<Dim>::face_slot(std::int32_t g, const std::vector<st
   x_face.setZero();
   for (const std::int64_t p : pts) {
     const Mat<Dim> D = points_.F[p] * points_.domain[p];
-    const Vec<Dim> dn = D.transpose() * n;
-    const double tol = 1e-9 * D.cwiseAbs().maxCoeff();
-    Vec<Dim> s;
-    for (int d = 0; d < Dim; ++d) s[d] = std::abs(dn[d]) <= tol ? 0.0 : (dn[d] > 0 ? -1.0 : 1.0);
-    int free_axes = 0;
-    for (int d = 0; d < Dim; ++d) free_axes += s[d] == 0.0;
-    const int corners = 1 << free_axes;
+    const Mat<Dim> m = D.inverse().transpose();  // columns: face normals m_k (unnormalised)
+    int axis = 0;
+    double best = -1;
+    for (int d = 0; d < Dim; ++d) {
+      const double align = std::abs(m.col(d).dot(n)) / m.col(d).norm();
+      if (align > best) {
+        best = align;
+        axis = d;
+      }
+    }
+    Vec<Dim> s = Vec<Dim>::Zero();
+    s[axis] = m.col(axis).dot(n) > 0 ? -1.0 : 1.0;
+    const int corners = 1 << (Dim - 1);
     x_face += (points_.x[p] + D * s) / static_cast<double>(pts.size());
     for (int c = 0; c < corners; ++c) {
       Vec<Dim> sc = s;
