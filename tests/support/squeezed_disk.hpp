@@ -1,0 +1,136 @@
+#pragma once
+// The squeezed disk of issue 14 through `mpmcd run`, against the project's independent
+// finite-element solution (tests/reference/squeezed_disk, FEniCS, mesh-converged to 0.014 %):
+// a Neo-Hookean disk (R = 1 mm, mu = 1.5 MPa, rho = 990 kg/m^3, polar seeding, 2 points per cell)
+// between two frictionless walls closing at 0.01 c_s each (0.389 m/s, c_s = sqrt(mu/rho)),
+// CPDI + affine P2G (docs/accuracy.md, "The squeezed disk"). The plate force, averaged over
+// Delta/D +- 0.01 (the impulses chatter as node rows meet the walls), is compared with the FE
+// force at Delta/D = 0.05 ... 0.39, and the stored energy with the walls' work. Shared by
+// tests/verification/squeeze_fe (default suite) and long_squeeze_fe (ctest --preset long).
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_runner.hpp"
+#include "mpmcd/analysis/time_series.hpp"
+
+namespace mpmcd::test_support::squeeze {
+
+namespace fs = std::filesystem;
+
+inline constexpr double kRadius = 1e-3, kMu = 1.5e6, kRho = 990.0;
+inline const double kSpeed = 0.01 * std::sqrt(kMu / kRho);                       // each wall [m/s]
+inline const std::vector<double> kStations = {0.05, 0.1, 0.15, 0.2, 0.3, 0.39};  // Delta/D [-]
+
+// FE force P(Delta/D) [N/m] for `lambda` [Pa], from tests/reference/squeezed_disk.
+struct FeCurve {
+  std::vector<double> x, force;
+  double at(double d) const {
+    const auto it = std::lower_bound(x.begin(), x.end(), d);
+    const auto i = static_cast<std::size_t>(
+        std::clamp<std::ptrdiff_t>(it - x.begin(), 1, static_cast<std::ptrdiff_t>(x.size()) - 1));
+    return force[i - 1] + (force[i] - force[i - 1]) * (d - x[i - 1]) / (x[i] - x[i - 1]);
+  }
+};
+
+inline FeCurve fe_curve(double lambda) {
+  std::ifstream in(std::string(MPMCD_SOURCE_DIR) +
+                   "/tests/reference/squeezed_disk/squeezed_disk_fe.csv");
+  FeCurve c;
+  std::string line;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header) {  // lambda_Pa,mu_Pa,R_m,delta_over_D,force_N_per_m,...
+      header = false;
+      continue;
+    }
+    std::stringstream ss(line);
+    std::string f;
+    std::vector<double> v;
+    while (std::getline(ss, f, ',')) v.push_back(std::stod(f));
+    if (v.size() >= 5 && v[0] == lambda) {
+      c.x.push_back(v[3]);
+      c.force.push_back(v[4]);
+    }
+  }
+  return c;
+}
+
+struct DiskRun {
+  std::vector<double> ratio;  // MPM force / FE force at kStations [-]
+  double stored = 0;          // elastic + kinetic change / work of both walls at the end [-]
+};
+
+// Runs the disk at R/h = `rh` with step `dt` [s] and wall speed `speed` [m/s] to Delta/D = 0.4,
+// the walls acting on the grid nodes (`wall_contact` "nodes") or on the points' faces ("points").
+inline DiskRun run_disk(int rh, double lambda, double dt, double speed,
+                        const std::string& wall_contact = "nodes") {
+  const double h = kRadius / rh, t_end = 0.4 * kRadius / speed;
+  const std::string tag = fmt::format("{}_{:g}_{:g}_{:g}_{}", rh, lambda, dt, speed, wall_contact);
+  const fs::path dir = fs::temp_directory_path() / ("mpmcd_squeeze_fe_" + tag);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "disk.toml") << fmt::format(
+      "[simulation]\nname = \"disk\"\n"
+      "[grid]\norigin = [-2e-3, -1.5e-3]\nextent = [4e-3, 3e-3]\ncell_size = {:.17g}\n"
+      "shape_function = \"cpdi\"\n"
+      "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = {}\nlambda = {:.17g}\n"
+      "mu = {}\n"
+      "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.0, 0.0]\nradius = {}\n"
+      "points_per_cell = 2\n"
+      "[time]\ndt = {:.17g}\nend_time = {:.17g}\n"
+      "[solver]\naffine = true\n"
+      "[contact]\nfriction = 0.0\nwall_contact = \"{}\"\n"
+      "[[walls]]\nname = \"bottom\"\npoint = [0.0, {}]\nnormal = [0.0, 1.0]\n"
+      "velocity = [0.0, {:.17g}]\n"
+      "[[walls]]\nname = \"top\"\npoint = [0.0, {}]\nnormal = [0.0, -1.0]\n"
+      "velocity = [0.0, {:.17g}]\n"
+      "[output]\ncsv_interval = {:.17g}\nvtu = false\n",
+      h, kRho, lambda, kMu, kRadius, dt, t_end, wall_contact, -kRadius, speed, kRadius, -speed,
+      t_end / 400);
+  const auto r = mpmcd::test_support::run("run -q -t 1 " + (dir / "disk.toml").string() + " -o " +
+                                          (dir / "out").string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  const auto s = mpmcd::analysis::read_time_series((dir / "out" / "disk.csv").string());
+  const auto &t = s.column("time"), &top = s.column("wall_top_fy"),
+             &bottom = s.column("wall_bottom_fy");
+  const FeCurve fe = fe_curve(lambda);
+  DiskRun out;
+  for (double x : kStations) {
+    double f = 0, p = 0;  // sums over the window Delta/D in (x - 0.01, x + 0.01)
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const double d = 2 * speed * t[i] / (2 * kRadius);  // Delta/D
+      if (std::abs(d - x) >= 0.01) continue;
+      f += 0.5 * (top[i] - bottom[i]);  // the grains push the top wall up, the bottom one down
+      p += fe.at(d);
+    }
+    out.ratio.push_back(p > 0 ? f / p : 0.0);
+  }
+  const double work = s.column("wall_top_work").back() + s.column("wall_bottom_work").back();
+  out.stored = s.column("energy_change").back() / work;
+  return out;
+}
+
+inline void print(const std::string& label, const DiskRun& r) {
+  std::string line = "  " + label + ": force / FE";
+  for (std::size_t k = 0; k < kStations.size(); ++k)
+    line += fmt::format("  {:.2f}: {:.4f}", kStations[k], r.ratio[k]);
+  std::printf("%s; stored / wall work %.4f\n", line.c_str(), r.stored);
+}
+
+inline double worst(const DiskRun& r) {
+  double e = 0;
+  for (double q : r.ratio) e = std::max(e, std::abs(q - 1));
+  return e;
+}
+
+}  // namespace mpmcd::test_support::squeeze
