@@ -28,9 +28,7 @@ using SpMat = Eigen::SparseMatrix<double>;
 template <int Dim>
 class PrescribedNodes {
  public:
-  /// No node prescribed.
-  PrescribedNodes() = default;
-  /// `node_count` grid nodes [-], none prescribed.
+  /// A grid of `node_count` nodes [-], none prescribed.
   explicit PrescribedNodes(std::int64_t node_count) {
     mask_.assign(static_cast<std::size_t>(node_count), 0);
     for (int d = 0; d < Dim; ++d) set_[d].assign(mask_.size(), -1);
