@@ -91,7 +91,7 @@ void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   // matrix. Column (j, d) of E is sum_k w_jk e_{a_jk, d} (one node of weight 1 for a node slot).
   GrainWork& w = *work_[g];
   if (!w.lumped_group) {
-    if (!reuse_factor(w) && !prepare_factor(g, dt_)) return;
+    if (!reuse_factor(w, settings_) && !grain_factor(g, dt_)) return;
     // Z and G depend only on the factorisation and the slots (fixed within a step).
     if (w.z_factor == w.factor_count) return;
     w.z_factor = w.factor_count;
@@ -123,7 +123,7 @@ void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   }
   if (!w.lumped_group)
     for (Eigen::Index c = 0; c < Dim * k; ++c)
-      if (w.Z.col(c).squaredNorm() > 0) w.Z.col(c) = linear_solve(g, w.Z.col(c));
+      if (w.Z.col(c).squaredNorm() > 0) w.Z.col(c) = linear_solve(w, settings_, w.Z.col(c));
   G.resize(Dim * k, Dim * k);
   for (Eigen::Index i = 0; i < k; ++i) {
     const std::size_t s = static_cast<std::size_t>(w.slots[i]);

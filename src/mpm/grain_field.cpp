@@ -1,12 +1,12 @@
 // The grain field's transfers (multi-field MPM, method.md §1-2): P2G with the active nodes and the
-// sparse pattern of the Newton matrix (setup_grain), G2P (g2p_point, commit_grain) and its check
-// of the next positions, and the field's diagnostics.
+// sparse pattern of the Newton matrix (p2g), G2P (g2p_point, g2p_commit) and its check of the next
+// positions (g2p_check), and the field's diagnostics (include/mpmcd/mpm/grain_field.hpp).
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
-#include "solver_detail.hpp"
+#include "mpmcd/mpm/grain_field.hpp"
 
 namespace mpmcd::mpm {
 
@@ -17,15 +17,14 @@ void reset(std::vector<T>& v, std::size_t n, const T& value) {
 }
 }  // namespace
 
-template <int Dim>
-template <class S1>
-void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
+template <class S1, int Dim>
+void p2g(GrainField<Dim>& w, const grid::Grid<Dim>& grid, const Settings<Dim>& settings,
+         const points::PointSet<Dim>& points, const points::Grain& gr,
+         const PrescribedNodes<Dim>& prescribed) {
   using Shape = typename grid::ShapeOf<Dim, S1>::type;
   constexpr int K = Shape::K;
-  GrainWork& w = *work_[g];
-  const points::Grain& gr = grains_[g];
   const std::int64_t np = gr.size();
-  const double h = grid_.cell_size();
+  const double h = grid.cell_size();
   w.K = K;
   w.converged = false;
   w.solved_once = false;
@@ -40,7 +39,6 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   w.project_tangent = false;
   w.projections = 0;
   w.shrunk_domains = 0;
-  w.z_factor = -1;
   w.pt_first.resize(np);
   w.pt_N.resize(np * K);
   w.pt_dN.resize(np * K);
@@ -51,12 +49,12 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   Shape ps;
   for (std::int64_t i = 0; i < np; ++i) {
     const std::int64_t p = gr.begin + i;
-    const Mat<Dim> D = points_.F[p] * points_.domain[p];
-    if (!ps.eval(points_.x[p], grid_.origin(), h, gr.half_width, D)) {
+    const Mat<Dim> D = points.F[p] * points.domain[p];
+    if (!ps.eval(points.x[p], grid.origin(), h, gr.half_width, D)) {
       // A CPDI domain stretched over more than two cells along an axis: its shape functions use
       // it shrunk to the window (grid::fit_cpdi_window), counted in StepStats::shrunk_domains.
       ++w.shrunk_domains;
-      if (!ps.eval(points_.x[p], grid_.origin(), h, gr.half_width,
+      if (!ps.eval(points.x[p], grid.origin(), h, gr.half_width,
                    grid::fit_cpdi_window<Dim>(D, h))) {
         w.failure = "material point domain does not fit the CPDI window";
         w.fail_point = p;
@@ -71,8 +69,8 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
     lo = lo.cwiseMin(ps.first);
     hi = hi.cwiseMax(ps.first + IVec<Dim>::Constant(S1::kNodes - 1));
     if ((ps.first.array() < 0).any() ||
-        ((ps.first.array() + S1::kNodes - 1) >= grid_.nodes_per_axis().array()).any() ||
-        !points_.x[p].allFinite()) {
+        ((ps.first.array() + S1::kNodes - 1) >= grid.nodes_per_axis().array()).any() ||
+        !points.x[p].allFinite()) {
       w.failure =
           "material point left the grid (or came within the shape-function support of its edge)";
       w.retryable = false;
@@ -91,19 +89,19 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   reset(w.box_mv, nb, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.box_f, nb, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.box_fext, nb, Vec<Dim>(Vec<Dim>::Zero()));
-  const bool contact = settings_.contact.enabled;
-  const bool affine = settings_.affine;
+  const bool contact = settings.contact.enabled;
+  const bool affine = settings.affine;
   if (contact) reset(w.box_gm, nb, Vec<Dim>(Vec<Dim>::Zero()));
   // Pass 2: P2G (method.md §2): m_I = sum N m_p, m_I v_I = sum N m_p v_p,
   // f_I^n = -sum V_p sigma_p grad N_I (seed eq. 5) + sum N m_p g.
   for (std::int64_t i = 0; i < np; ++i) {
     const std::int64_t p = gr.begin + i;
     const IVec<Dim> base = w.pt_first[i] - lo;
-    const double mp = points_.mass[p];
-    const Vec<Dim> mv = mp * points_.v[p];
-    const Mat<Dim> mL = mp * points_.L[p];
-    const Vec<Dim> mg = mp * settings_.gravity;
-    const Mat<Dim> Vs = points_.volume[p] * points_.sigma[p];
+    const double mp = points.mass[p];
+    const Vec<Dim> mv = mp * points.v[p];
+    const Mat<Dim> mL = mp * points.L[p];
+    const Vec<Dim> mg = mp * settings.gravity;
+    const Mat<Dim> Vs = points.volume[p] * points.sigma[p];
     for (int a = 0; a < K; ++a) {
       IVec<Dim> c = base;
       for (int d = 0; d < Dim; ++d) c[d] += Shape::offset(a, d);
@@ -112,7 +110,7 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
       w.box_m[b] += N * mp;
       w.box_mv[b] += N * mv;
       // Affine P2G: + N m_p L_p (x_I - x_p) (Settings::affine).
-      if (affine) w.box_mv[b] += N * (mL * (grid_.node_position(c + lo) - points_.x[p]));
+      if (affine) w.box_mv[b] += N * (mL * (grid.node_position(c + lo) - points.x[p]));
       w.box_f[b] -= Vs * w.pt_dN[i * K + a];
       w.box_fext[b] += N * mg;
       if (contact) w.box_gm[b] += mp * w.pt_dN[i * K + a];  // grad m_I = sum m_p grad N_I (§4)
@@ -134,13 +132,13 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   // Active nodes carry more than round-off mass (uGIMP tails at a material edge lying on a grid
   // line give weights ~1e-17 that would only make the Newton matrix ill-conditioned).
   double mp_max = 0;
-  for (std::int64_t i = 0; i < np; ++i) mp_max = std::max(mp_max, points_.mass[gr.begin + i]);
+  for (std::int64_t i = 0; i < np; ++i) mp_max = std::max(mp_max, points.mass[gr.begin + i]);
   // CPDI (docs/accuracy.md): a domain corner just past a grid line gives its far nodes weights
   // down to round-off; such a node's velocity is the ratio of two vanishing forces and, when a
   // wall face rests on it, it spoils the contact problem (measured: the walled block's exact state
   // lost at s = 0.80 with 1e-13; exact to s = 0.5 with 1e-6). The mass left out (below 1e-6 of a
   // point's per node) is the price: momentum drift ~1e-6 instead of round-off.
-  const double m_min = (settings_.shape == grid::ShapeKind::kCpdi ? 1e-6 : 1e-13) * mp_max;
+  const double m_min = (settings.shape == grid::ShapeKind::kCpdi ? 1e-6 : 1e-13) * mp_max;
   for (std::size_t b = 0; b < nb; ++b) {
     if (!(w.box_m[b] > m_min)) continue;
     w.box_to_active[b] = static_cast<std::int32_t>(w.m.size());
@@ -151,7 +149,7 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
       r /= w.box_n[d];
     }
     w.node_box.push_back(c);
-    w.node_global.push_back(grid_.node_index(c + lo));
+    w.node_global.push_back(grid.node_index(c + lo));
     w.m.push_back(w.box_m[b]);
     w.v_p2g.push_back(w.box_mv[b] / w.box_m[b]);
     w.f_n.push_back(w.box_f[b] + w.box_fext[b]);
@@ -195,18 +193,18 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   w.v_n = w.v_p2g;
   for (std::size_t a = 0; a < na; ++a) {
     const std::int64_t n = w.node_global[a];
-    const std::uint8_t mk = bc_mask_[n];
+    const std::uint8_t mk = prescribed.mask(n);
     if (!mk) continue;
     w.mask[a] = mk;
-    const Vec<Dim> xn = grid_.node_position(w.node_box[a] + lo);
+    const Vec<Dim> xn = grid.node_position(w.node_box[a] + lo);
     for (int d = 0; d < Dim; ++d)
-      if (mk & (1u << d)) w.v_n[a][d] = bcs_[bc_set_[d][n]].value(xn)[d];
+      if (mk & (1u << d)) w.v_n[a][d] = prescribed.value(n, d, xn);
   }
   w.v = w.v_n;  // initial guess: zero acceleration
   // Energy ledger: what the P2G (and the prescribed values) keep of the points' kinetic energy.
   w.kin_points_n = w.kin_grid_n = 0;
   for (std::int64_t i = 0; i < np; ++i)
-    w.kin_points_n += 0.5 * points_.mass[gr.begin + i] * points_.v[gr.begin + i].squaredNorm();
+    w.kin_points_n += 0.5 * points.mass[gr.begin + i] * points.v[gr.begin + i].squaredNorm();
   for (std::size_t a = 0; a < na; ++a) w.kin_grid_n += 0.5 * w.m[a] * w.v_n[a].squaredNorm();
   reset(w.f_int, na, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.f_abs, na, Vec<Dim>(Vec<Dim>::Zero()));
@@ -215,10 +213,10 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
     // Node -> points lists (for the gaps) and the contact mass threshold of this grain.
     double m_sum = 0, v_sum = 0;
     for (std::int64_t i = 0; i < np; ++i) {
-      m_sum += points_.mass[gr.begin + i];
-      v_sum += points_.volume0[gr.begin + i];
+      m_sum += points.mass[gr.begin + i];
+      v_sum += points.volume0[gr.begin + i];
     }
-    w.contact_mass = settings_.contact.mass_fraction * m_sum / v_sum * std::pow(h, Dim);
+    w.contact_mass = settings.contact.mass_fraction * m_sum / v_sum * std::pow(h, Dim);
     w.node_pts_start.assign(na + 1, 0);
     for (std::int64_t i = 0; i < np; ++i)
       for (int a = 0; a < K; ++a)
@@ -234,7 +232,6 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
   }
   reset(w.R, na, Vec<Dim>(Vec<Dim>::Zero()));
   reset(w.du, na, Vec<Dim>(Vec<Dim>::Zero()));
-  (void)dt;
   // The pattern (stencil, sparse structure, symbolic factorisation) depends only on the active
   // node set: reuse it when unchanged (the usual case at small dt).
   if (same_box && w.box_to_active == w.prev_box_to_active) return;
@@ -296,17 +293,15 @@ void ImplicitSolver<Dim>::setup_grain(std::size_t g, double dt) {
           w.value_index[((a * w.S + s) * Dim + i) * Dim + j] = pos - inner;
         }
     }
-  if (settings_.linear_solver == LinearSolverKind::kLdlt) w.ldlt.analyzePattern(w.A);
-  if (settings_.linear_solver == LinearSolverKind::kLu) w.lu.analyzePattern(w.A);
+  if (settings.linear_solver == LinearSolverKind::kLdlt) w.ldlt.analyzePattern(w.A);
+  if (settings.linear_solver == LinearSolverKind::kLu) w.lu.analyzePattern(w.A);
 }
 
-template <int Dim>
-template <class S1>
-typename ImplicitSolver<Dim>::G2P ImplicitSolver<Dim>::g2p_point(const GrainWork& w, std::int64_t p,
-                                                                 std::int64_t i,
-                                                                 bool with_grad) const {
+template <class S1, int Dim>
+G2pUpdate<Dim> g2p_point(const GrainField<Dim>& w, double flip, const points::PointSet<Dim>& points,
+                         std::int64_t p, std::int64_t i, bool with_grad) {
   constexpr int K = grid::ShapeOf<Dim, S1>::type::K;
-  const double alpha = settings_.flip;
+  const double alpha = flip;
   Vec<Dim> dx = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero(), vpic = Vec<Dim>::Zero();
   Mat<Dim> grad_v = Mat<Dim>::Zero();
   for (int a = 0; a < K; ++a) {
@@ -319,51 +314,50 @@ typename ImplicitSolver<Dim>::G2P ImplicitSolver<Dim>::g2p_point(const GrainWork
     if (with_grad) grad_v += w.v[n] * w.pt_dN[i * K + a].transpose();
   }
   // v_p = flip (v_p + sum N dv) + (1 - flip) sum N v (method.md §2).
-  return {dx, alpha * (points_.v[p] + dv) + (1.0 - alpha) * vpic, grad_v};
+  return {dx, alpha * (points.v[p] + dv) + (1.0 - alpha) * vpic, grad_v};
 }
 
-template <int Dim>
-template <class S1>
-void ImplicitSolver<Dim>::commit_grain(std::size_t g) {
-  const points::Grain& gr = grains_[g];
-  const GrainWork& w = *work_[g];
+template <class S1, int Dim>
+void g2p_commit(const GrainField<Dim>& w, const TrialState<Dim>& trial,
+                const Settings<Dim>& settings, points::PointSet<Dim>& points,
+                const points::Grain& gr) {
   for (std::int64_t i = 0; i < gr.size(); ++i) {
     const std::int64_t p = gr.begin + i;
-    const G2P u = g2p_point<S1>(w, p, i, settings_.affine);
+    const G2pUpdate<Dim> u = g2p_point<S1>(w, settings.flip, points, p, i, settings.affine);
     // Velocity gradient at x^{n+1} for the next affine P2G: grad_{x^n} v dF^-1 (Settings::affine).
-    if (settings_.affine) points_.L[p] = u.grad_v * dF_inv_T_[p].transpose();
+    if (settings.affine) points.L[p] = u.grad_v * trial.dF_inv_T[p].transpose();
     // G2P: x_p += sum N du (method.md §2).
-    points_.x[p] += u.dx;
-    points_.v[p] = u.v;
-    points_.F[p] = F_trial_[p];
-    points_.sigma[p] = sigma_trial_[p];
-    if constexpr (Dim == 2) points_.sigma_zz[p] = sigma_zz_trial_[p];
-    points_.volume[p] = J_trial_[p] * points_.volume0[p];
+    points.x[p] += u.dx;
+    points.v[p] = u.v;
+    points.F[p] = trial.F[p];
+    points.sigma[p] = trial.sigma[p];
+    if constexpr (Dim == 2) points.sigma_zz[p] = trial.sigma_zz[p];
+    points.volume[p] = trial.J[p] * points.volume0[p];
   }
 }
 
-template <int Dim>
-template <class S1>
-void ImplicitSolver<Dim>::check_next_positions(std::size_t g) {
+template <class S1, int Dim>
+void g2p_check(GrainField<Dim>& w, const TrialState<Dim>& trial, const grid::Grid<Dim>& grid,
+               const Settings<Dim>& settings, const points::PointSet<Dim>& points,
+               const points::Grain& gr) {
   using Shape = typename grid::ShapeOf<Dim, S1>::type;
-  GrainWork& w = *work_[g];
-  const points::Grain& gr = grains_[g];
-  const double h = grid_.cell_size();
+  const double h = grid.cell_size();
   Shape ps;
   w.kin_points = 0;
   for (std::int64_t i = 0; i < gr.size(); ++i) {
     const std::int64_t p = gr.begin + i;
-    const G2P u = g2p_point<S1>(w, p, i, false);  // commit_grain's position and velocity
-    w.kin_points += 0.5 * points_.mass[p] * u.v.squaredNorm();
-    const Vec<Dim> x = points_.x[p] + u.dx;
+    // g2p_commit's position and velocity
+    const G2pUpdate<Dim> u = g2p_point<S1>(w, settings.flip, points, p, i, false);
+    w.kin_points += 0.5 * points.mass[p] * u.v.squaredNorm();
+    const Vec<Dim> x = points.x[p] + u.dx;
     // A domain stretched too far is left to the next step's set-up (a retryable failure there);
     // its position must still lie on the grid.
     const bool off =
         !x.allFinite() ||
-        (ps.eval(x, grid_.origin(), h, gr.half_width, F_trial_[p] * points_.domain[p])
+        (ps.eval(x, grid.origin(), h, gr.half_width, trial.F[p] * points.domain[p])
              ? ((ps.first.array() < 0).any() ||
-                ((ps.first.array() + S1::kNodes - 1) >= grid_.nodes_per_axis().array()).any())
-             : !grid_.inside(x, 0.0));
+                ((ps.first.array() + S1::kNodes - 1) >= grid.nodes_per_axis().array()).any())
+             : !grid.inside(x, 0.0));
     if (off) {
       w.failure =
           "material point left the grid (or came within the shape-function support of its edge)";
@@ -375,30 +369,35 @@ void ImplicitSolver<Dim>::check_next_positions(std::size_t g) {
 }
 
 template <int Dim>
-double ImplicitSolver<Dim>::field_mass(std::size_t g) const {
+double field_mass(const GrainField<Dim>& w) {
   double m = 0;
-  for (double x : work_.at(g)->m) m += x;
+  for (double x : w.m) m += x;
   return m;
 }
 
 template <int Dim>
-Vec<Dim> ImplicitSolver<Dim>::field_momentum(std::size_t g) const {
+Vec<Dim> field_momentum(const GrainField<Dim>& w) {
   Vec<Dim> p = Vec<Dim>::Zero();
-  const GrainWork& w = *work_.at(g);
   for (std::size_t a = 0; a < w.m.size(); ++a) p += w.m[a] * w.v[a];
   return p;
 }
 
-// The members defined here, for each dimension and shape family (the class is instantiated in
-// solver.cpp).
-#define MPMCD_INSTANTIATE_SHAPE(D, S1)                                   \
-  template void ImplicitSolver<D>::setup_grain<S1>(std::size_t, double); \
-  template void ImplicitSolver<D>::commit_grain<S1>(std::size_t);        \
-  template void ImplicitSolver<D>::check_next_positions<S1>(std::size_t);
-#define MPMCD_INSTANTIATE(D)                                        \
-  MPMCD_FOR_EACH_SHAPE(MPMCD_INSTANTIATE_SHAPE, D)                  \
-  template double ImplicitSolver<D>::field_mass(std::size_t) const; \
-  template Vec<D> ImplicitSolver<D>::field_momentum(std::size_t) const;
+// The stages defined here, for each dimension and shape family.
+#define MPMCD_INSTANTIATE_SHAPE(D, S1)                                                             \
+  template void p2g<S1, D>(GrainField<D>&, const grid::Grid<D>&, const Settings<D>&,               \
+                           const points::PointSet<D>&, const points::Grain&,                       \
+                           const PrescribedNodes<D>&);                                             \
+  template G2pUpdate<D> g2p_point<S1, D>(const GrainField<D>&, double, const points::PointSet<D>&, \
+                                         std::int64_t, std::int64_t, bool);                        \
+  template void g2p_check<S1, D>(GrainField<D>&, const TrialState<D>&, const grid::Grid<D>&,       \
+                                 const Settings<D>&, const points::PointSet<D>&,                   \
+                                 const points::Grain&);                                            \
+  template void g2p_commit<S1, D>(const GrainField<D>&, const TrialState<D>&, const Settings<D>&,  \
+                                  points::PointSet<D>&, const points::Grain&);
+#define MPMCD_INSTANTIATE(D)                           \
+  MPMCD_FOR_EACH_SHAPE(MPMCD_INSTANTIATE_SHAPE, D)     \
+  template double field_mass<D>(const GrainField<D>&); \
+  template Vec<D> field_momentum<D>(const GrainField<D>&);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)
 #undef MPMCD_INSTANTIATE

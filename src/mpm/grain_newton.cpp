@@ -1,6 +1,7 @@
-// One Newton iteration of a grain (method.md §2): kinematics, law and residual (evaluate_grain),
-// the consistent tangent (assemble_tangent), the Newton matrix and its factorisation, the linear
-// solve and the modified-Newton reuse of a factorisation.
+// One Newton iteration of a grain (method.md §2): kinematics, law and residual (evaluate), the
+// consistent tangent (assemble_tangent), the Newton matrix and its factorisation (factorize,
+// prepare_factor), the linear solve, the modified-Newton reuse of a factorisation and the update
+// (newton_solve) (include/mpmcd/mpm/grain_field.hpp).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -8,20 +9,19 @@
 #include <limits>
 #include <span>
 
-#include "solver_detail.hpp"
+#include "mpmcd/mpm/grain_field.hpp"
 
 namespace mpmcd::mpm {
 
-template <int Dim>
-template <class S1>
-void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
+template <class S1, int Dim>
+void evaluate(GrainField<Dim>& w, TrialState<Dim>& trial, const Settings<Dim>& settings,
+              const points::PointSet<Dim>& points, const points::Grain& gr,
+              const materials::Law<Dim>& law, double dt) {
   using Shape = typename grid::ShapeOf<Dim, S1>::type;
   constexpr int K = Shape::K;
-  GrainWork& w = *work_[g];
-  const points::Grain& gr = grains_[g];
   const std::int64_t np = gr.size();
   const std::size_t na = w.m.size();
-  const double theta = settings_.theta;
+  const double theta = settings.theta;
   w.tangent_current = w.factor_current = false;
   // Nodal increment du_I = dt [(1 - theta) v_I^n + theta v_I^{n+1}] (method.md §2).
   for (std::size_t a = 0; a < na; ++a) w.du[a] = dt * ((1.0 - theta) * w.v_n[a] + theta * w.v[a]);
@@ -33,28 +33,27 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
       const std::int32_t n = w.pt_node[i * K + a];
       if (n >= 0) dF += w.du[n] * w.pt_dN[i * K + a].transpose();
     }
-    F_trial_[p] = dF * points_.F[p];
-    const double J = F_trial_[p].determinant();
-    J_trial_[p] = J;
+    trial.F[p] = dF * points.F[p];
+    const double J = trial.F[p].determinant();
+    trial.J[p] = J;
     if (!(J > 0.0) || !std::isfinite(J)) {
       w.failure = fmt::format("J = {:.3g} <= 0 (inverted material point)", J);
       w.fail_point = p;
       return;
     }
-    dF_inv_T_[p] = dF.inverse().transpose();
+    trial.dF_inv_T[p] = dF.inverse().transpose();
   }
-  const materials::Law<Dim>& law = *laws_[gr.material];
   const auto off = static_cast<std::size_t>(gr.begin);
   const auto cnt = static_cast<std::size_t>(np);
   const std::size_t hs = static_cast<std::size_t>(law.history_size());
   materials::LawBatch<Dim> batch{
-      std::span<const Mat<Dim>>(F_trial_.data() + off, cnt),
-      std::span<const double>(points_.history.data() + gr.history_offset, hs * cnt),
-      std::span<double>(history_trial_.data() + gr.history_offset, hs * cnt),
-      std::span<Mat<Dim>>(sigma_trial_.data() + off, cnt),
-      std::span<Tensor4<Dim>>(tangent_.data() + off, cnt),
+      std::span<const Mat<Dim>>(trial.F.data() + off, cnt),
+      std::span<const double>(points.history.data() + gr.history_offset, hs * cnt),
+      std::span<double>(trial.history.data() + gr.history_offset, hs * cnt),
+      std::span<Mat<Dim>>(trial.sigma.data() + off, cnt),
+      std::span<Tensor4<Dim>>(trial.tangent.data() + off, cnt),
       {},
-      Dim == 2 ? std::span<double>(sigma_zz_trial_.data() + off, cnt) : std::span<double>()};
+      Dim == 2 ? std::span<double>(trial.sigma_zz.data() + off, cnt) : std::span<double>()};
   law.evaluate(batch);
   // Internal force f_I = -sum V sigma grad_{x^{n+1}} N_I with grad_{x^{n+1}} N = dF^-T grad_{x^n} N
   // (seed eq. 5 at n+1, method.md §2).
@@ -62,13 +61,13 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
   std::fill(w.f_abs.begin(), w.f_abs.end(), Vec<Dim>::Zero());
   for (std::int64_t i = 0; i < np; ++i) {
     const std::int64_t p = gr.begin + i;
-    const Mat<Dim>& sig = sigma_trial_[p];
+    const Mat<Dim>& sig = trial.sigma[p];
     if (!sig.allFinite()) {
       w.failure = "non-finite stress";
       w.fail_point = p;
       return;
     }
-    const Mat<Dim> Vsig_dFinvT = J_trial_[p] * points_.volume0[p] * sig * dF_inv_T_[p];
+    const Mat<Dim> Vsig_dFinvT = trial.J[p] * points.volume0[p] * sig * trial.dF_inv_T[p];
     for (int a = 0; a < K; ++a) {
       const std::int32_t n = w.pt_node[i * K + a];
       if (n < 0) continue;
@@ -105,7 +104,8 @@ void ImplicitSolver<Dim>::evaluate_grain(std::size_t g, double dt) {
   }
   // Velocity scale of the increment test (mass norm): sqrt(sum m max(|v^{n+1}|^2, |v^n|^2)) plus
   // the velocity change the step's forces and impulses can produce, res_ref / sqrt(M) (a body at
-  // rest has no velocity scale of its own). The convergence decision is taken in solve_step.
+  // rest has no velocity scale of its own). The convergence decision is the caller's
+  // (ImplicitSolver::solve_step).
   double vref2 = 0, mass = 0;
   for (std::size_t a = 0; a < na; ++a) {
     vref2 += w.m[a] * std::max(w.v[a].squaredNorm(), w.v_n[a].squaredNorm());
@@ -131,13 +131,11 @@ const Tensor4<Dim>& projected(const Tensor4<Dim>& a, Tensor4<Dim>& scratch) {
 
 }  // namespace
 
-template <int Dim>
-template <class S1>
-void ImplicitSolver<Dim>::assemble_tangent(std::size_t g) {
+template <class S1, int Dim>
+void assemble_tangent(GrainField<Dim>& w, const TrialState<Dim>& trial,
+                      const points::PointSet<Dim>& points, const points::Grain& gr) {
   using Shape = typename grid::ShapeOf<Dim, S1>::type;
   constexpr int K = Shape::K;
-  GrainWork& w = *work_[g];
-  const points::Grain& gr = grains_[g];
   // Tangent blocks K_IJ,ik = sum V g_I,j a_ijkl g_J,l, g = dF^-T grad_{x^n} N (material +
   // geometric, method.md §2), accumulated into the block stencil through the pair -> slot table.
   // With project_tangent each point's a is first projected onto the positive semi-definite
@@ -148,10 +146,11 @@ void ImplicitSolver<Dim>::assemble_tangent(std::size_t g) {
   Tensor4<Dim> Tp;  // the projected tangent of the current point
   for (std::int64_t i = 0; i < gr.size(); ++i) {
     const std::int64_t p = gr.begin + i;
-    const double V = J_trial_[p] * points_.volume0[p];
-    const Tensor4<Dim>& T = w.project_tangent ? projected<Dim>(tangent_[p], Tp) : tangent_[p];
+    const double V = trial.J[p] * points.volume0[p];
+    const Tensor4<Dim>& T =
+        w.project_tangent ? projected<Dim>(trial.tangent[p], Tp) : trial.tangent[p];
     for (int a = 0; a < K; ++a) {
-      gx[a] = dF_inv_T_[p] * w.pt_dN[i * K + a];
+      gx[a] = trial.dF_inv_T[p] * w.pt_dN[i * K + a];
       if (w.pt_node[i * K + a] < 0) continue;
       // Ma(i, kl) = V sum_j g_j a(ij, kl)
       for (int ii = 0; ii < Dim; ++ii)
@@ -181,10 +180,9 @@ void ImplicitSolver<Dim>::assemble_tangent(std::size_t g) {
 }
 
 template <int Dim>
-bool ImplicitSolver<Dim>::factorize_grain(std::size_t g, double dt) {
-  GrainWork& w = *work_[g];
+bool factorize(GrainField<Dim>& w, const Settings<Dim>& settings, double dt) {
   const std::size_t na = w.m.size();
-  const double c = settings_.theta * settings_.theta * dt * dt;
+  const double c = settings.theta * settings.theta * dt * dt;
   double* val = w.A.valuePtr();
   // Newton matrix dR/dv^{n+1} = M + theta^2 dt^2 K (method.md §2); prescribed rows and columns
   // are replaced by m_I on the diagonal so the matrix stays symmetric positive definite.
@@ -205,7 +203,7 @@ bool ImplicitSolver<Dim>::factorize_grain(std::size_t g, double dt) {
         }
     }
   bool ok = true;
-  switch (settings_.linear_solver) {
+  switch (settings.linear_solver) {
     case LinearSolverKind::kLdlt:
       w.ldlt.factorize(w.A);
       ok = w.ldlt.info() == Eigen::Success;
@@ -215,8 +213,8 @@ bool ImplicitSolver<Dim>::factorize_grain(std::size_t g, double dt) {
       ok = w.lu.info() == Eigen::Success;
       break;
     case LinearSolverKind::kCg:
-      w.cg.setTolerance(settings_.cg_tolerance);
-      w.cg.setMaxIterations(settings_.cg_max_iterations);
+      w.cg.setTolerance(settings.cg_tolerance);
+      w.cg.setMaxIterations(settings.cg_max_iterations);
       w.cg.compute(w.A);
       break;
   }
@@ -229,14 +227,16 @@ bool ImplicitSolver<Dim>::factorize_grain(std::size_t g, double dt) {
 }
 
 template <int Dim>
-bool ImplicitSolver<Dim>::prepare_factor(std::size_t g, double dt) {
-  GrainWork& w = *work_[g];
+bool prepare_factor(GrainField<Dim>& w, const TrialState<Dim>& trial, const Settings<Dim>& settings,
+                    const points::PointSet<Dim>& points, const points::Grain& grain,
+                    const materials::Law<Dim>& law, bool compliance, double dt) {
   if (w.factor_current) return true;
   const auto assemble = [&] {
-    detail::with_shape(settings_.shape, [&](auto tag) { assemble_tangent<decltype(tag)>(g); });
+    with_shape(settings.shape,
+               [&](auto tag) { assemble_tangent<decltype(tag)>(w, trial, points, grain); });
   };
   if (!w.tangent_current) assemble();
-  if (!factorize_grain(g, dt)) return false;
+  if (!factorize(w, settings, dt)) return false;
   // Under compression the geometric term delta_ik sigma_jl makes a point's tangent indefinite
   // (on rotations), and modes that strain no point (edge nodes of a block, rigid rotation) then
   // give M + theta^2 dt^2 K negative eigenvalues once dt^2 |sigma| / h^2 exceeds the nodal
@@ -244,21 +244,18 @@ bool ImplicitSolver<Dim>::prepare_factor(std::size_t g, double dt) {
   // (docs/accuracy.md). A grain whose factorisation gives a compliance then uses the projected
   // tangent for the step; the Newton iterations still converge to the same state, linearly. A
   // grain without contact keeps the exact tangent (quadratic convergence).
-  if (w.project_tangent || w.slots.empty() || w.lumped_group ||
-      settings_.linear_solver != LinearSolverKind::kLdlt ||
-      !laws_[grains_[g].material]->symmetric_tangent() || (w.ldlt.vectorD().array() > 0).all())
+  if (w.project_tangent || !compliance || settings.linear_solver != LinearSolverKind::kLdlt ||
+      !law.symmetric_tangent() || (w.ldlt.vectorD().array() > 0).all())
     return true;
   w.project_tangent = true;
   ++w.projections;
   assemble();
-  return factorize_grain(g, dt);
+  return factorize(w, settings, dt);
 }
 
-template <int Dim>
-template <class Rhs>
-Eigen::VectorXd ImplicitSolver<Dim>::linear_solve(std::size_t g, const Rhs& rhs) {
-  GrainWork& w = *work_[g];
-  switch (settings_.linear_solver) {
+template <int Dim, class Rhs>
+Eigen::VectorXd linear_solve(GrainField<Dim>& w, const Settings<Dim>& settings, const Rhs& rhs) {
+  switch (settings.linear_solver) {
     case LinearSolverKind::kLdlt:
       return w.ldlt.solve(rhs);
     case LinearSolverKind::kLu:
@@ -273,25 +270,26 @@ Eigen::VectorXd ImplicitSolver<Dim>::linear_solve(std::size_t g, const Rhs& rhs)
 }
 
 template <int Dim>
-bool ImplicitSolver<Dim>::reuse_factor(const GrainWork& w) const {
+bool reuse_factor(const GrainField<Dim>& w, const Settings<Dim>& settings) {
   // Modified Newton (Settings::modified_newton): the step's first factorisation serves all its
   // iterations and contact updates, unless the residual stalls (falls by less than half over an
   // iteration), when the tangent is rebuilt.
-  if (!settings_.modified_newton || !w.factor_in_step) return false;
+  if (!settings.modified_newton || !w.factor_in_step) return false;
   const auto n = w.history.size();
   return n < 2 || w.history[n - 1] < 0.5 * w.history[n - 2];
 }
 
 template <int Dim>
-void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt, bool reuse) {
-  GrainWork& w = *work_[g];
+void newton_solve(GrainField<Dim>& w, const TrialState<Dim>& trial, const Settings<Dim>& settings,
+                  const points::PointSet<Dim>& points, const points::Grain& grain,
+                  const materials::Law<Dim>& law, bool compliance, double dt, bool reuse) {
   const std::size_t na = w.m.size();
-  if (!reuse && !prepare_factor(g, dt)) return;
+  if (!reuse && !prepare_factor(w, trial, settings, points, grain, law, compliance, dt)) return;
   w.rhs.resize(static_cast<Eigen::Index>(na * Dim));
   for (std::size_t a = 0; a < na; ++a)
     for (int d = 0; d < Dim; ++d) w.rhs[a * Dim + d] = -w.R[a][d];
-  w.sol = linear_solve(g, w.rhs);
-  w.cg_work = settings_.linear_solver == LinearSolverKind::kCg
+  w.sol = linear_solve(w, settings, w.rhs);
+  w.cg_work = settings.linear_solver == LinearSolverKind::kCg
                   ? static_cast<double>(w.cg.iterations()) * static_cast<double>(w.A.nonZeros())
                   : static_cast<double>(w.A.nonZeros());
   if (!w.sol.allFinite()) {
@@ -309,19 +307,28 @@ void ImplicitSolver<Dim>::solve_grain(std::size_t g, double dt, bool reuse) {
   ++w.solves;
 }
 
-// The members defined here, for each dimension and shape family (the class is instantiated in
-// solver.cpp); linear_solve also for the columns of the compliance (grain_compliance).
-#define MPMCD_INSTANTIATE_SHAPE(D, S1)                                      \
-  template void ImplicitSolver<D>::evaluate_grain<S1>(std::size_t, double); \
-  template void ImplicitSolver<D>::assemble_tangent<S1>(std::size_t);
-#define MPMCD_INSTANTIATE(D)                                                         \
-  MPMCD_FOR_EACH_SHAPE(MPMCD_INSTANTIATE_SHAPE, D)                                   \
-  template bool ImplicitSolver<D>::factorize_grain(std::size_t, double);             \
-  template bool ImplicitSolver<D>::prepare_factor(std::size_t, double);              \
-  template Eigen::VectorXd ImplicitSolver<D>::linear_solve<Eigen::MatrixXd::ColXpr>( \
-      std::size_t, const Eigen::MatrixXd::ColXpr&);                                  \
-  template bool ImplicitSolver<D>::reuse_factor(const GrainWork&) const;             \
-  template void ImplicitSolver<D>::solve_grain(std::size_t, double, bool);
+// The stages defined here, for each dimension and shape family; linear_solve for the Newton update
+// and for the columns of the contact compliance (ImplicitSolver::grain_compliance).
+#define MPMCD_INSTANTIATE_SHAPE(D, S1)                                              \
+  template void evaluate<S1, D>(GrainField<D>&, TrialState<D>&, const Settings<D>&, \
+                                const points::PointSet<D>&, const points::Grain&,   \
+                                const materials::Law<D>&, double);                  \
+  template void assemble_tangent<S1, D>(GrainField<D>&, const TrialState<D>&,       \
+                                        const points::PointSet<D>&, const points::Grain&);
+#define MPMCD_INSTANTIATE(D)                                                                    \
+  MPMCD_FOR_EACH_SHAPE(MPMCD_INSTANTIATE_SHAPE, D)                                              \
+  template bool factorize<D>(GrainField<D>&, const Settings<D>&, double);                       \
+  template bool prepare_factor<D>(GrainField<D>&, const TrialState<D>&, const Settings<D>&,     \
+                                  const points::PointSet<D>&, const points::Grain&,             \
+                                  const materials::Law<D>&, bool, double);                      \
+  template Eigen::VectorXd linear_solve<D, Eigen::VectorXd>(GrainField<D>&, const Settings<D>&, \
+                                                            const Eigen::VectorXd&);            \
+  template Eigen::VectorXd linear_solve<D, Eigen::MatrixXd::ColXpr>(                            \
+      GrainField<D>&, const Settings<D>&, const Eigen::MatrixXd::ColXpr&);                      \
+  template bool reuse_factor<D>(const GrainField<D>&, const Settings<D>&);                      \
+  template void newton_solve<D>(GrainField<D>&, const TrialState<D>&, const Settings<D>&,       \
+                                const points::PointSet<D>&, const points::Grain&,               \
+                                const materials::Law<D>&, bool, double, bool);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)
 #undef MPMCD_INSTANTIATE

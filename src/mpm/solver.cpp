@@ -1,6 +1,7 @@
 // ImplicitSolver: construction, boundary conditions, the step (P2G, Newton iterations staggered
-// with contact, the G2P check, the step's statistics) and its commit. The stages live in
-// grain_field.cpp, grain_newton.cpp, contact_detect.cpp, contact_coupling.cpp and
+// with contact, the G2P check, the step's statistics) and its commit. The grain field's stages are
+// free functions (include/mpmcd/mpm/grain_field.hpp: grain_field.cpp, grain_newton.cpp); the
+// contact stages live in contact_detect.cpp and contact_coupling.cpp, the distributed step in
 // solver_distributed.cpp (docs/architecture.md, "The mpm module's files").
 #include "mpmcd/mpm/solver.hpp"
 
@@ -30,36 +31,32 @@ ImplicitSolver<Dim>::ImplicitSolver(const grid::Grid<Dim>& grid, const Settings<
                                     points::PointSet<Dim>& points,
                                     const std::vector<points::Grain>& grains,
                                     std::vector<const materials::Law<Dim>*> laws)
-    : grid_(grid), settings_(settings), points_(points), grains_(grains), laws_(std::move(laws)) {
-  bc_mask_.assign(static_cast<std::size_t>(grid_.node_count()), 0);
-  for (int d = 0; d < Dim; ++d) bc_set_[d].assign(bc_mask_.size(), -1);
-}
+    : grid_(grid),
+      settings_(settings),
+      points_(points),
+      grains_(grains),
+      laws_(std::move(laws)),
+      prescribed_(grid_.node_count()) {}
 
 template <int Dim>
 ImplicitSolver<Dim>::~ImplicitSolver() = default;
 
 template <int Dim>
 void ImplicitSolver<Dim>::set_boundary_conditions(const std::vector<VelocityBC<Dim>>& bcs) {
-  // Clear only the nodes set before (moving node sets are replaced every step).
-  for (const auto& old : bcs_)
-    for (std::int64_t n : old.nodes) {
-      bc_mask_[n] = 0;
-      for (int d = 0; d < Dim; ++d) bc_set_[d][n] = -1;
-    }
-  bcs_ = bcs;
-  for (std::size_t s = 0; s < bcs_.size(); ++s)
-    for (std::int64_t n : bcs_[s].nodes) {
-      bc_mask_[n] |= bcs_[s].mask;
-      for (int d = 0; d < Dim; ++d)
-        if (bcs_[s].mask & (1u << d)) bc_set_[d][n] = static_cast<std::int32_t>(s);
-    }
+  prescribed_.set(bcs);  // clears only the nodes set before (moving node sets change every step)
+}
+
+template <int Dim>
+bool ImplicitSolver<Dim>::grain_factor(std::size_t g, double dt) {
+  GrainWork& w = *work_[g];
+  const points::Grain& gr = grains_[g];
+  return prepare_factor(w, trial_, settings_, points_, gr, *laws_[gr.material], w.compliance(), dt);
 }
 
 template <int Dim>
 StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   StepStats stats;
   const std::size_t ng = grains_.size();
-  const std::size_t np = points_.size();
   dt_ = dt;
   step_ready_ = false;
   if (work_.size() != ng) {
@@ -78,13 +75,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     }
   local_ = owned_;
   const std::size_t no = owned_.size();
-  F_trial_.resize(np);
-  sigma_trial_.resize(np);
-  dF_inv_T_.resize(np);
-  sigma_zz_trial_.resize(np);
-  J_trial_.resize(np);
-  tangent_.resize(np);
-  history_trial_ = points_.history;
+  trial_.start(points_);
   // This rank's lowest failing grain into stats; true if there is one.
   auto local_failure = [&]() {
     for (std::size_t g : owned_)
@@ -107,7 +98,11 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
 #pragma omp parallel for schedule(dynamic, 1) if (no > 1)
     for (std::size_t i = 0; i < no; ++i) {
       const std::size_t g = owned_[i];
-      detail::with_shape(settings_.shape, [&](auto tag) { setup_grain<decltype(tag)>(g, dt); });
+      GrainWork& w = *work_[g];
+      w.z_factor = -1;
+      with_shape(settings_.shape, [&](auto tag) {
+        p2g<decltype(tag)>(w, grid_, settings_, points_, grains_[g], prescribed_);
+      });
     }
   }
   // Work counts (docs/parallel.md): per grain and phase for re-balancing, where P2G, detection
@@ -152,8 +147,10 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         const std::size_t g = owned_[i];
         GrainWork& w = *work_[g];
         if (w.converged || !w.failure.empty()) continue;
-        detail::with_shape(settings_.shape,
-                           [&](auto tag) { evaluate_grain<decltype(tag)>(g, dt); });
+        const points::Grain& gr = grains_[g];
+        with_shape(settings_.shape, [&](auto tag) {
+          evaluate<decltype(tag)>(w, trial_, settings_, points_, gr, *laws_[gr.material], dt);
+        });
         if (w.failure.empty()) w.iterations = it;
         const auto u = static_cast<double>(grains_[g].size());
         phase_work(g, it) += u;
@@ -227,7 +224,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         const std::size_t g = owned_[i];
         GrainWork& w = *work_[g];
         if (w.converged || !w.failure.empty()) continue;
-        solve_grain(g, dt, reuse_factor(w));
+        const points::Grain& gr = grains_[g];
+        newton_solve(w, trial_, settings_, points_, gr, *laws_[gr.material], w.compliance(), dt,
+                     reuse_factor(w, settings_));
         const double u = kCgWorkWeight * w.cg_work;
         phase_work(g, it) += u;
         units += u;
@@ -279,8 +278,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
 #pragma omp parallel for schedule(dynamic, 1) if (no > 1)
     for (std::size_t i = 0; i < no; ++i) {
       const std::size_t g = owned_[i];
-      detail::with_shape(settings_.shape,
-                         [&](auto tag) { check_next_positions<decltype(tag)>(g); });
+      with_shape(settings_.shape, [&](auto tag) {
+        g2p_check<decltype(tag)>(*work_[g], trial_, grid_, settings_, points_, grains_[g]);
+      });
     }
   }
   if (collect_failure()) {
@@ -373,10 +373,22 @@ void ImplicitSolver<Dim>::commit() {
 #pragma omp parallel for schedule(dynamic, 1) if (no > 1)
   for (std::size_t i = 0; i < no; ++i) {
     const std::size_t g = owned_[i];
-    detail::with_shape(settings_.shape, [&](auto tag) { commit_grain<decltype(tag)>(g); });
+    with_shape(settings_.shape, [&](auto tag) {
+      g2p_commit<decltype(tag)>(*work_[g], trial_, settings_, points_, grains_[g]);
+    });
   }
-  points_.history.swap(history_trial_);
+  points_.history.swap(trial_.history);
   step_ready_ = false;
+}
+
+template <int Dim>
+double ImplicitSolver<Dim>::field_mass(std::size_t g) const {
+  return mpm::field_mass<Dim>(*work_.at(g));
+}
+
+template <int Dim>
+Vec<Dim> ImplicitSolver<Dim>::field_momentum(std::size_t g) const {
+  return mpm::field_momentum<Dim>(*work_.at(g));
 }
 
 template class ImplicitSolver<2>;

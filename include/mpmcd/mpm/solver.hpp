@@ -14,102 +14,13 @@
 #include "mpmcd/grid/grid.hpp"
 #include "mpmcd/grid/shape.hpp"
 #include "mpmcd/materials/law.hpp"
+#include "mpmcd/mpm/grain_field.hpp"
+#include "mpmcd/mpm/settings.hpp"
 #include "mpmcd/parallel/comm.hpp"
 #include "mpmcd/parallel/partition.hpp"
 #include "mpmcd/points/point_set.hpp"
 
 namespace mpmcd::mpm {
-
-/// Linear solver used for each grain's Newton system.
-enum class LinearSolverKind {
-  kLdlt,  ///< sparse direct LDL^T (Eigen SimplicialLDLT), symmetric tangents
-  kLu,    ///< sparse direct LU (Eigen SparseLU), any tangent
-  kCg,    ///< Jacobi-preconditioned conjugate gradients (mass-dominated systems, small dt)
-};
-
-/// Parses "ldlt" / "lu" / "cg"; throws InputError otherwise.
-LinearSolverKind linear_solver_from_string(const std::string& name);
-
-/// A rigid wall: the plane through `point` + velocity t with unit `normal` pointing into the
-/// domain; it takes part in contact as a body of infinite mass.
-template <int Dim>
-struct Wall {
-  std::string name;                      ///< name used in outputs
-  Vec<Dim> point = Vec<Dim>::Zero();     ///< a point of the plane at t = 0 [m]
-  Vec<Dim> normal = Vec<Dim>::Zero();    ///< unit normal into the domain [-]
-  Vec<Dim> velocity = Vec<Dim>::Zero();  ///< prescribed velocity [m/s]
-  double friction = 0.0;                 ///< Coulomb coefficient with every grain [-]
-  /// Signed distance of x [m] from the wall at time t [s] (positive inside the domain) [m].
-  double distance(const Vec<Dim>& x, double t) const {
-    return (x - point - t * velocity).dot(normal);
-  }
-};
-
-/// When a grain-grain contact switches on (method.md §4).
-enum class GapCriterion {
-  kGap,      ///< gap from the points' domains: contact when the materials meet
-  kOverlap,  ///< pure support overlap: any node where both fields carry mass (about a cell early)
-};
-
-/// Contact Dynamics settings (method.md §4).
-template <int Dim>
-struct ContactSettings {
-  bool enabled = false;                         ///< solve contacts between grains and with walls
-  GapCriterion criterion = GapCriterion::kGap;  ///< grain-grain gap criterion
-  double mass_fraction =
-      1e-4;           ///< a field takes part at a node above this fraction of a cell's mass
-  int materials = 1;  ///< number of materials (size of the friction matrix)
-  std::vector<double> friction = {
-      0.0};                      ///< mu_f per material pair, row-major materials x materials
-  std::vector<Wall<Dim>> walls;  ///< rigid walls
-  double wall_range = 1.0;       ///< grain nodes within this many cells of a wall are candidates
-  /// Where a wall acts (docs/accuracy.md): false = at grain nodes (the node velocity may not
-  /// cross the wall), true = at the faces of the points' domains facing the wall (the velocity
-  /// of the face, interpolated from the nodes, may not cross it), which holds the material edge,
-  /// not a node beyond it, at the wall. Points within wall_range cells of a wall are candidates.
-  bool wall_points = false;
-  contact::GsSettings gs;           ///< Gauss-Seidel tolerance and sweep limit
-  double impulse_tolerance = 1e-6;  ///< relative change of impulses between Newton iterations [-]
-  /// Delassus operator: true = each grain's exact compliance at its contact nodes from its
-  /// factorised Newton matrix (direct linear solvers), false = lumped 1/m_I.
-  bool grain_compliance = true;
-};
-
-/// Numerical settings of the implicit step.
-template <int Dim>
-struct Settings {
-  grid::ShapeKind shape = grid::ShapeKind::kLinear;  ///< shape functions
-  double theta = 1.0;                                ///< theta in [1/2, 1] (method.md §2) [-]
-  int max_iterations = 25;            ///< Newton iterations before the step fails [-]
-  double residual_tolerance = 1e-8;   ///< |R| <= tol * (|M v^n| + dt |f|) [-]
-  double increment_tolerance = 1e-8;  ///< |dv|_M <= tol * |v|_M (mass norms) [-]
-  LinearSolverKind linear_solver = LinearSolverKind::kLdlt;  ///< per-grain linear solver
-  double cg_tolerance = 1e-12;                               ///< relative CG residual [-]
-  int cg_max_iterations = 1000;                              ///< CG iteration cap [-]
-  double flip = 1.0;  ///< FLIP fraction of the G2P velocity update [-]
-  /// Affine P2G (APIC, Jiang et al. 2015, with the velocity gradient as the affine matrix, as in
-  /// TPIC, Nakamura et al. 2023): m_I v_I = sum N m_p (v_p + L_p (x_I - x_p)), L_p carried by the
-  /// points, so that a linear velocity field is transferred exactly whatever the positions.
-  bool affine = false;
-  /// Modified Newton: factorise the Newton matrix once per step and reuse it (and the contact
-  /// compliance computed from it) in the later iterations; refactorised when the residual
-  /// stalls. Same converged answer, fewer factorisations (docs/accuracy.md, cost).
-  bool modified_newton = true;
-  Vec<Dim> gravity = Vec<Dim>::Zero();  ///< body acceleration [m/s^2]
-  ContactSettings<Dim> contact;         ///< contact between grains and with walls
-};
-
-/// Prescribed velocity components on a set of grid nodes: v(x) = velocity + gradient (x - anchor).
-template <int Dim>
-struct VelocityBC {
-  std::vector<std::int64_t> nodes;       ///< global node indices
-  std::uint8_t mask = 0;                 ///< bit d set: component d is prescribed
-  Vec<Dim> velocity = Vec<Dim>::Zero();  ///< uniform part [m/s]
-  Mat<Dim> gradient = Mat<Dim>::Zero();  ///< velocity gradient [1/s]
-  Vec<Dim> anchor = Vec<Dim>::Zero();    ///< point where v = velocity [m]
-  /// Prescribed velocity at node position x [m] -> [m/s].
-  Vec<Dim> value(const Vec<Dim>& x) const { return velocity + gradient * (x - anchor); }
-};
 
 /// Outcome of one attempted step.
 struct StepStats {
@@ -157,8 +68,9 @@ struct WarmImpulse {
   Vec<Dim> impulse = Vec<Dim>::Zero();  ///< impulse on b over the step [N s] (2D: N s/m)
 };
 
-/// Implicit MPM stepper: grains with their own nodal fields, coupled by Contact Dynamics.
-/// Holds non-owning references to the points, grains and laws, which must outlive it.
+/// Implicit MPM stepper: grains with their own nodal fields (GrainField, whose stages it calls
+/// grain by grain), coupled by Contact Dynamics. Holds non-owning references to the points,
+/// grains and laws, which must outlive it.
 template <int Dim>
 class ImplicitSolver {
  public:
@@ -220,21 +132,9 @@ class ImplicitSolver {
 
  private:
   struct GrainWork;
-  template <class S1>
-  void setup_grain(std::size_t g, double dt);
-  template <class S1>
-  void evaluate_grain(std::size_t g, double dt);
-  template <class S1>
-  void assemble_tangent(std::size_t g);
-  bool factorize_grain(std::size_t g, double dt);
-  /// Assembles (if stale) and factorises grain g's Newton matrix; an indefinite LDL^T is redone
-  /// with the projected tangent (assemble_tangent). False on a failed factorisation.
-  bool prepare_factor(std::size_t g, double dt);
-  template <class Rhs>
-  Eigen::VectorXd linear_solve(std::size_t g, const Rhs& rhs);
-  void solve_grain(std::size_t g, double dt, bool reuse);
-  /// True if grain work w solves with its existing factorisation (Settings::modified_newton).
-  bool reuse_factor(const GrainWork& w) const;
+  // Grain g's Newton matrix, assembled (if stale) and factorised: prepare_factor with the solver's
+  // points, law and the grain's contact compliance. False on a failed factorisation.
+  bool grain_factor(std::size_t g, double dt);
   void grain_compliance(std::size_t g);
   void detect_contacts(double dt);
   double update_contacts(StepStats& stats);
@@ -256,37 +156,14 @@ class ImplicitSolver {
   void exchange_entries();
   void exchange_requests();
   double update_contacts_distributed(StepStats& stats);
-  // G2P of point p, the i-th of its grain (method.md §2): position increment sum N du, new velocity
-  // flip (v_p + sum N (v - v_p2g)) + (1 - flip) sum N v, and (if with_grad) the velocity gradient
-  // sum v (x) grad N, else zero.
-  struct G2P {
-    Vec<Dim> dx, v;
-    Mat<Dim> grad_v;
-  };
-  template <class S1>
-  G2P g2p_point(const GrainWork& w, std::int64_t p, std::int64_t i, bool with_grad) const;
-  template <class S1>
-  void commit_grain(std::size_t g);
-  // Fails grain g's step (not retryable) if a point's position after it, x + sum N du, would put
-  // its shape-function support past the grid's edge (the check setup_grain makes at x^n); sums
-  // the points' kinetic energy after the G2P for the energy ledger.
-  template <class S1>
-  void check_next_positions(std::size_t g);
-
   grid::Grid<Dim> grid_;
   Settings<Dim> settings_;
   points::PointSet<Dim>& points_;
   const std::vector<points::Grain>& grains_;
   std::vector<const materials::Law<Dim>*> laws_;
   std::vector<std::unique_ptr<GrainWork>> work_;
-  // Per global node: prescribed mask and index of the BC set giving each component.
-  std::vector<std::uint8_t> bc_mask_;
-  std::vector<std::int32_t> bc_set_[Dim];
-  std::vector<VelocityBC<Dim>> bcs_;
-  // Trial state per point (committed only by commit()).
-  std::vector<Mat<Dim>> F_trial_, sigma_trial_, dF_inv_T_;
-  std::vector<double> sigma_zz_trial_, J_trial_, history_trial_;
-  std::vector<Tensor4<Dim>> tangent_;
+  PrescribedNodes<Dim> prescribed_;  // prescribed velocity components per global node
+  TrialState<Dim> trial_;            // trial state per point (committed only by commit())
   // Contact state: the problem of the step, slot -> (grain, active node), warm-start impulses.
   contact::Problem<Dim> problem_;
   std::vector<std::pair<std::int32_t, std::int32_t>> slot_ref_;
