@@ -211,6 +211,23 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   };
   std::vector<std::vector<Candidate>> found(shared.size());
   const auto nshared = static_cast<std::int64_t>(shared.size());
+  // Reach of each point's domain, sum_i |F r_i| >= extent(p, e) for any unit e [m]: a pair
+  // whose distance minus both reaches is not below the gap found so far cannot lower it and is
+  // skipped (the same gap, far fewer extents: the point pairs of a CPDI node are most of the
+  // detection's time otherwise).
+  if (cs.criterion == GapCriterion::kGap) {
+    point_reach_.resize(points_.x.size());
+    const auto nl = static_cast<std::int64_t>(local_.size());
+#pragma omp parallel for schedule(dynamic, 4) if (nl > 1)
+    for (std::int64_t i = 0; i < nl; ++i) {
+      const points::Grain& gr = grains_[local_[static_cast<std::size_t>(i)]];
+      for (std::int64_t p = gr.begin; p < gr.end; ++p) {
+        double r = 0;
+        for (int d = 0; d < Dim; ++d) r += (points_.F[p] * points_.domain[p].col(d)).norm();
+        point_reach_[p] = r;
+      }
+    }
+  }
   // Work count (Comm::count_work): node fields, pairs and point pairs of the gaps examined here.
   double items = static_cast<double>(entries.size());
   ThreadedRegion threaded(&timers_, nshared > 256);
@@ -249,6 +266,10 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
                 gap = 0;
                 continue;
               }
+              // The bound with a margin of 1e-12 of the reaches, so that round-off in the bound
+              // never skips a pair that would lower the gap.
+              const double reach = point_reach_[p] + point_reach_[q];
+              if (len_d - reach > gap + 1e-12 * reach) continue;
               const Vec<Dim> e = d / len_d;
               gap = std::min(gap, len_d - extent(p, e) - extent(q, e));
             }

@@ -232,6 +232,8 @@ class ImplicitSolver {
   std::pair<std::size_t, std::size_t> link_sizes() const;
   // Items of the last contact detection on this rank [-].
   double detect_items_ = 0;
+  // Per point: sum_i |F r_i|, a bound of its domain's extent along any direction [m].
+  std::vector<double> point_reach_;
   static constexpr double kCgWorkWeight = 0.048;
   double time_ = 0.0;
   double dt_ = 0.0;
