@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -95,14 +96,14 @@ bool threaded_problem(const Problem<Dim>& p) {
 }
 
 template <int Dim>
-std::vector<Vec<Dim>> slot_velocities(const Problem<Dim>& p) {
+std::vector<Vec<Dim>> slot_velocities(const Problem<Dim>& p, bool threads) {
   std::vector<Vec<Dim>> v(p.slots.size());
   for (std::size_t s = 0; s < p.slots.size(); ++s) v[s] = p.slots[s].v_free;
   const auto net = net_impulses(p);
   // A group's impulses move its own slots only: the groups on the threads, each summing its
   // slots' responses in its slot order (the same bits for any thread count).
   const auto ng = static_cast<std::int64_t>(p.groups.size());
-#pragma omp parallel for schedule(dynamic, 4) if (threaded_problem(p))
+#pragma omp parallel for schedule(dynamic, 4) if (threads)
   for (std::int64_t g = 0; g < ng; ++g)
     for (const std::int32_t s : p.groups[g].slots)
       if (net[s] != Vec<Dim>::Zero()) respond(p, v, s, net[s]);
@@ -333,8 +334,7 @@ bool solve_node_block(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const std::int3
 
 template <int Dim>
 void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, StageTimers* timers,
-           double omega, bool node_blocks) {
-  const bool threads = threaded_problem(p);
+           double omega, bool node_blocks, bool threads) {
   const ThreadedRegion threaded(timers, threads);
   for (std::size_t ph = 0; ph + 1 < runs.phase.size(); ++ph)
 #pragma omp parallel for schedule(dynamic, 8) if (threads)
@@ -367,21 +367,33 @@ void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, Stag
 }
 
 // The sweeps until error() <= tolerance or max_sweeps, error() giving the (global) error.
+// error_now(threads) gives the error, its sums on the threads or not. With a tuner each sweep and
+// its error run on the threads or on one thread as the tuner chooses (the same bits either way:
+// the colours fix the order), and their time per contact is recorded.
 template <int Dim, class Error>
 GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& error_now) {
   GsResult r;
-  r.error = error_now();
+  const bool can_thread = threaded_problem(p) && omp_get_max_threads() > 1;
+  ThreadTuner* const tuner = can_thread ? settings.tuner : nullptr;
+  r.error = error_now(can_thread);
   if (r.error <= settings.tolerance) {
     r.converged = true;
     return r;
   }
-  auto v = slot_velocities(p);
+  auto v = slot_velocities(p, can_thread);
   const NodeRuns runs = node_runs(p);
+  const double work = static_cast<double>(p.contacts.size());
   while (r.sweeps < settings.max_sweeps) {
+    const bool threads = tuner ? tuner->threaded() : can_thread;
+    const auto t0 = std::chrono::steady_clock::now();
     sweep(p, v, runs, settings.timers, r.sweeps >= settings.relax_after ? settings.relaxation : 1.0,
-          settings.node_blocks);
+          settings.node_blocks, threads);
     ++r.sweeps;
-    r.error = error_now();
+    r.error = error_now(threads);
+    if (tuner)
+      tuner->record(
+          threads,
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / work);
     if (r.error <= settings.tolerance) {
       r.converged = true;
       break;
@@ -397,15 +409,19 @@ double error_ratio(double num, double den) {
 
 }  // namespace
 
+namespace {
+
+// error_terms, its loops on the threads if `threads`.
 template <int Dim>
-void error_terms(const Problem<Dim>& p, double& num, double& den, StageTimers* timers) {
-  const auto v = slot_velocities(p);
+void error_sums(const Problem<Dim>& p, double& num, double& den, StageTimers* timers,
+                bool threads) {
+  const auto v = slot_velocities(p, threads);
   // Each contact's terms on the threads, summed in contact order (the same bits for any count).
   const auto n = static_cast<std::int64_t>(p.contacts.size());
   std::vector<double> tn(static_cast<std::size_t>(n)), td(static_cast<std::size_t>(n));
   {
-    const ThreadedRegion threaded(timers, threaded_problem(p));
-#pragma omp parallel for schedule(static) if (threaded_problem(p))
+    const ThreadedRegion threaded(timers, threads);
+#pragma omp parallel for schedule(static) if (threads)
     for (std::int64_t i = 0; i < n; ++i) {
       const Contact<Dim>& c = p.contacts[i];
       Vec<Dim> u;
@@ -424,12 +440,19 @@ void error_terms(const Problem<Dim>& p, double& num, double& den, StageTimers* t
   }
 }
 
+}  // namespace
+
+template <int Dim>
+void error_terms(const Problem<Dim>& p, double& num, double& den, StageTimers* timers) {
+  error_sums(p, num, den, timers, threaded_problem(p));
+}
+
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings,
                             const ErrorReduce& reduce) {
-  return gauss_seidel(p, settings, [&]() {
+  return gauss_seidel(p, settings, [&](bool threads) {
     double num = 0, den = 0;
-    error_terms(p, num, den, settings.timers);
+    error_sums(p, num, den, settings.timers, threads);
     reduce(num, den);
     return error_ratio(num, den);
   });
@@ -444,9 +467,9 @@ double error(const Problem<Dim>& p) {
 
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings) {
-  return gauss_seidel(p, settings, [&]() {
+  return gauss_seidel(p, settings, [&](bool threads) {
     double num = 0, den = 0;
-    error_terms(p, num, den, settings.timers);
+    error_sums(p, num, den, settings.timers, threads);
     return error_ratio(num, den);
   });
 }

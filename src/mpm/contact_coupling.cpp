@@ -145,20 +145,28 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   threaded.done();
   for (const auto& w : work_)
     if (!w->failure.empty()) return 1.0;
-  // Free velocities: the grains' current iterates without their contact impulses (method.md §4).
-  for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
-    const GrainWork& w = *work_[slot_ref_[s].first];
-    const std::int32_t a = slot_ref_[s].second;
-    auto& slot = problem_.slots[s];
-    if (!slot_is_face_[s]) slot.mass = w.m[a];
-    if (slot.group < 0) {  // a node slot alone at its node (face slots are always grouped)
-      slot.v_free = w.v[a] - slot_P_[s] / w.m[a];
-    } else {
-      const auto& group = problem_.groups[slot.group];
-      slot.v_free = slot_is_face_[s] ? slot_velocity(s) : w.v[a];
-      for (std::size_t j = 0; j < group.slots.size(); ++j)
-        slot.v_free -=
-            group.G.template block<Dim, Dim>(Dim * slot.local, Dim * j) * slot_P_[group.slots[j]];
+  // Free velocities: the grains' current iterates without their contact impulses (method.md §4);
+  // each slot on its own (O(group size) for a grouped slot), on the threads.
+  const auto nslots = static_cast<std::int64_t>(slot_ref_.size());
+  {
+    const bool many = nslots > 256;
+    ThreadedRegion threaded_free(&timers_, many);
+#pragma omp parallel for schedule(dynamic, 64) if (many)
+    for (std::int64_t si = 0; si < nslots; ++si) {
+      const auto s = static_cast<std::size_t>(si);
+      const GrainWork& w = *work_[slot_ref_[s].first];
+      const std::int32_t a = slot_ref_[s].second;
+      auto& slot = problem_.slots[s];
+      if (!slot_is_face_[s]) slot.mass = w.m[a];
+      if (slot.group < 0) {  // a node slot alone at its node (face slots are always grouped)
+        slot.v_free = w.v[a] - slot_P_[s] / w.m[a];
+      } else {
+        const auto& group = problem_.groups[slot.group];
+        slot.v_free = slot_is_face_[s] ? slot_velocity(s) : w.v[a];
+        for (std::size_t j = 0; j < group.slots.size(); ++j)
+          slot.v_free -=
+              group.G.template block<Dim, Dim>(Dim * slot.local, Dim * j) * slot_P_[group.slots[j]];
+      }
     }
   }
   std::vector<Vec<Dim>> old(problem_.contacts.size());
@@ -194,7 +202,12 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     acc = std::max(acc, 0.0) + w.m[a] * (v_new - w.v[a]).squaredNorm();
     w.v[a] = v_new;
   }
-  for (const auto& group : problem_.groups) {
+  // Each group's response on the threads: a group is one grain's, and writes only that grain's
+  // velocities and its own slots' impulses.
+  ThreadedRegion threaded_response(&timers_, ngroups > 1);
+#pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1)
+  for (std::int64_t gi = 0; gi < ngroups; ++gi) {
+    const contact::Group& group = problem_.groups[static_cast<std::size_t>(gi)];
     const std::int32_t g = slot_ref_[group.slots[0]].first;
     GrainWork& w = *work_[g];
     Eigen::VectorXd dP(Dim * static_cast<Eigen::Index>(group.slots.size()));
@@ -222,6 +235,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     }
     dv2[g] = acc;
   }
+  threaded_response.done();
   if (!problem_.groups.empty()) spread_slot_impulses();
   for (std::size_t g = 0; g < work_.size(); ++g)
     if (dv2[g] >= 0.0) work_[g]->impulses_changed(dv2[g]);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "mpmcd/core/thread_tuner.hpp"
 #include "mpmcd/core/timer.hpp"
 #include "mpmcd/core/types.hpp"
 
@@ -68,6 +69,10 @@ struct GsSettings {
   bool node_blocks = true;
   /// Where the threaded sweeps and error sums add their time (ThreadedRegion); none if null.
   StageTimers* timers = nullptr;
+  /// Chooses sweep by sweep between the threads and one thread from their measured cost (the
+  /// same impulses either way: core/thread_tuner.hpp); null: the threads whenever the problem is
+  /// large enough.
+  ThreadTuner* tuner = nullptr;
 };
 
 /// Gauss-Seidel outcome.

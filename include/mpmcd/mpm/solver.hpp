@@ -222,12 +222,15 @@ class ImplicitSolver {
   static constexpr double kExchangeItemWeight = 0.1;
   static constexpr double kBoxTestWeight = 0.5;
   static constexpr double kPairTestWeight = 0.07;
-  // The Gauss-Seidel settings with this solver's timers (threaded sweeps, ThreadedRegion).
+  // The Gauss-Seidel settings with this solver's timers (threaded sweeps, ThreadedRegion) and its
+  // tuner (threads or one thread per sweep, by measured cost; kept from step to step).
   contact::GsSettings gs_settings() {
     contact::GsSettings gs = settings_.contact.gs;
     gs.timers = &timers_;
+    gs.tuner = &gs_tuner_;
     return gs;
   }
+  ThreadTuner gs_tuner_;
   // Slots this rank serves to others and asks from others (links_) [-].
   std::pair<std::size_t, std::size_t> link_sizes() const;
   // Items of the last contact detection on this rank [-].
