@@ -13,10 +13,11 @@ namespace mpmcd {
 /// the threaded step"). Only usable where both choices give the same bits (the loop's result does
 /// not depend on the thread count), so the choice changes the speed, never the answer.
 ///
-/// Each choice's cost is an exponential mean (weight 1/2) of the cost per unit of work [s]. The
-/// cheaper one is used; the other is tried again after `explore_every` repetitions, a gap that
-/// doubles (to kMaxGap) each time the trial loses and returns to kMinGap when it wins, so that a
-/// change of load is noticed while a losing choice costs at most about 1/kMaxGap of the time.
+/// Each choice's cost is an exponential mean (weight 1/2) of the cost per unit of work [s],
+/// restarted at each trial. The cheaper one is used; the other is tried again after `explore_every`
+/// repetitions, a gap that doubles (to kMaxGap) each time the trial loses and returns to kMinGap
+/// when it wins, so that a change of load is noticed while a losing choice costs at most about
+/// 1/kMaxGap of the time.
 class ThreadTuner {
  public:
   /// Whether the next repetition runs on the threads (the first repetitions measure both).
@@ -31,7 +32,8 @@ class ThreadTuner {
   /// Records the cost [s per unit of work] of a repetition run on the threads or not.
   void record(bool threaded, double cost) {
     double& c = cost_[threaded ? 1 : 0];
-    c = c < 0 ? cost : 0.5 * (c + cost);
+    // A trial's cost replaces the old mean, measured under a load that may have gone.
+    c = c < 0 || trying_ ? cost : 0.5 * (c + cost);
     if (trying_) {
       trying_ = false;
       const bool won =
