@@ -70,17 +70,40 @@ Mat<Dim> self_block(const Problem<Dim>& p, std::int32_t s) {
   return p.groups[sl.group].G.template block<Dim, Dim>(Dim * sl.local, Dim * sl.local);
 }
 
+// The slots' velocities during the sweeps, each group's slots stored contiguously in their local
+// order (then the slots without a group), so that a slot's response is one pass over a column
+// block of its group's G and a contiguous run of velocities. v[s] is slot s's velocity.
+template <int Dim>
+struct SlotVelocities {
+  std::vector<Vec<Dim>> value;      // by position [m/s]
+  std::vector<std::int32_t> pos;    // per slot: its position in value
+  std::vector<std::int32_t> first;  // per group: the position of its first slot
+  Vec<Dim>& operator[](std::int32_t s) { return value[static_cast<std::size_t>(pos[s])]; }
+  const Vec<Dim>& operator[](std::int32_t s) const {
+    return value[static_cast<std::size_t>(pos[s])];
+  }
+};
+
 // Adds the response to an impulse increment dP on slot s to the slot velocities v.
 template <int Dim>
-void respond(const Problem<Dim>& p, std::vector<Vec<Dim>>& v, std::int32_t s, const Vec<Dim>& dP) {
+void respond(const Problem<Dim>& p, SlotVelocities<Dim>& v, std::int32_t s, const Vec<Dim>& dP) {
   const Slot<Dim>& sl = p.slots[s];
   if (sl.group < 0) {
     v[s] += dP / sl.mass;
     return;
   }
+  // v_j += G_{j,s} dP for every slot j of the group: rows of G's columns Dim s .. Dim s + Dim - 1
+  // against the group's contiguous velocities, each entry summed over the columns in order (the
+  // bits of G.block(Dim j, Dim s) * dP).
   const Group& g = p.groups[sl.group];
-  for (std::size_t j = 0; j < g.slots.size(); ++j)
-    v[g.slots[j]] += g.G.template block<Dim, Dim>(Dim * j, Dim * sl.local) * dP;
+  const auto rows = static_cast<std::size_t>(g.G.rows());
+  const double* col = g.G.data() + static_cast<std::size_t>(Dim * sl.local) * rows;
+  double* out = v.value[static_cast<std::size_t>(v.first[sl.group])].data();
+  for (std::size_t i = 0; i < rows; ++i) {
+    double acc = col[i] * dP[0];
+    for (int d = 1; d < Dim; ++d) acc += col[static_cast<std::size_t>(d) * rows + i] * dP[d];
+    out[i] += acc;
+  }
 }
 
 // Contacts above which the per-node work is shared among threads (lumped operator: a contact
@@ -96,9 +119,20 @@ bool threaded_problem(const Problem<Dim>& p) {
 }
 
 template <int Dim>
-std::vector<Vec<Dim>> slot_velocities(const Problem<Dim>& p, bool threads) {
-  std::vector<Vec<Dim>> v(p.slots.size());
-  for (std::size_t s = 0; s < p.slots.size(); ++s) v[s] = p.slots[s].v_free;
+SlotVelocities<Dim> slot_velocities(const Problem<Dim>& p, bool threads) {
+  SlotVelocities<Dim> v;
+  const auto nslots = static_cast<std::int32_t>(p.slots.size());
+  v.value.resize(p.slots.size());
+  v.pos.assign(p.slots.size(), -1);
+  v.first.resize(p.groups.size());
+  std::int32_t next = 0;
+  for (std::size_t g = 0; g < p.groups.size(); ++g) {
+    v.first[g] = next;
+    for (const std::int32_t s : p.groups[g].slots) v.pos[s] = next++;
+  }
+  for (std::int32_t s = 0; s < nslots; ++s)
+    if (v.pos[s] < 0) v.pos[s] = next++;
+  for (std::int32_t s = 0; s < nslots; ++s) v[s] = p.slots[s].v_free;
   const auto net = net_impulses(p);
   // A group's impulses move its own slots only: the groups on the threads, each summing its
   // slots' responses in its slot order (the same bits for any thread count).
@@ -115,7 +149,7 @@ std::vector<Vec<Dim>> slot_velocities(const Problem<Dim>& p, bool threads) {
 
 // Relative free velocity of contact c (its own impulse removed) and its Delassus block W.
 template <int Dim>
-void free_velocity(const Problem<Dim>& p, const std::vector<Vec<Dim>>& v, const Contact<Dim>& c,
+void free_velocity(const Problem<Dim>& p, const SlotVelocities<Dim>& v, const Contact<Dim>& c,
                    Vec<Dim>& u_free, Mat<Dim>& W) {
   W = self_block(p, c.b);
   const Vec<Dim> vb = v[c.b] - W * c.impulse;
@@ -247,7 +281,7 @@ constexpr int kMaxBlock = 6;
 // contacts may be redundant: a light field pinched between two grains). Returns false, leaving
 // the impulses unchanged, when a contact has friction, k is out of range or no set fits.
 template <int Dim>
-bool solve_node_block(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const std::int32_t* idx, int k) {
+bool solve_node_block(Problem<Dim>& p, SlotVelocities<Dim>& v, const std::int32_t* idx, int k) {
   if (k < 2 || k > kMaxBlock) return false;
   using MatK = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxBlock, kMaxBlock>;
   using VecK = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxBlock, 1>;
@@ -333,7 +367,7 @@ bool solve_node_block(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const std::int3
 }
 
 template <int Dim>
-void sweep(Problem<Dim>& p, std::vector<Vec<Dim>>& v, const NodeRuns& runs, StageTimers* timers,
+void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const NodeRuns& runs, StageTimers* timers,
            double omega, bool node_blocks, bool threads) {
   const ThreadedRegion threaded(timers, threads);
   for (std::size_t ph = 0; ph + 1 < runs.phase.size(); ++ph)
