@@ -84,6 +84,49 @@ void ImplicitSolver<Dim>::spread_slot_impulses() {
         work_[slot_ref_[s].first]->P[slot_node_[k]] += slot_weight_[k] * slot_P_[s];
 }
 
+namespace {
+
+// Y = L^-1 P Z in place of w.Z (LDL^T of the grain's Newton matrix, P A P^T = L D L^T): the
+// column-by-column sparse solve of Eigen (x_r -= x_i L_ri for each column x with x_i != 0, i in
+// order) done on all columns at once, row by row of a row-major copy, so that each L_ri updates a
+// contiguous run of Y's row r: the same operations on every nonzero, vectorised. Each row keeps
+// the range of columns where it may be nonzero (a column outside is exactly 0 there and skipped,
+// as Eigen skips it); inside, an entry with x_i = 0 is updated by 0 (a zero's sign aside, the
+// same value). 3x cheaper than the per-column solve on the CPDI grains of the paper compaction.
+template <class Work>
+void forward_substitute(Work& w) {
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  RowMajor Y = w.ldlt.permutationP() * w.Z;
+  const auto n = Y.rows();
+  const auto ncol = Y.cols();
+  std::vector<Eigen::Index> lo(static_cast<std::size_t>(n), ncol),
+      hi(static_cast<std::size_t>(n), 0);
+  for (Eigen::Index r = 0; r < n; ++r)
+    for (Eigen::Index c = 0; c < ncol; ++c)
+      if (Y(r, c) != 0.0) {
+        lo[static_cast<std::size_t>(r)] = std::min(lo[static_cast<std::size_t>(r)], c);
+        hi[static_cast<std::size_t>(r)] = c + 1;
+      }
+  const auto& L = w.ldlt.matrixL().nestedExpression();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index a = lo[static_cast<std::size_t>(i)], b = hi[static_cast<std::size_t>(i)];
+    if (a >= b) continue;
+    const double* yi = Y.data() + i * ncol;
+    for (typename std::decay_t<decltype(L)>::InnerIterator it(L, i); it; ++it) {
+      const Eigen::Index r = it.index();
+      if (r <= i) continue;  // the unit diagonal (and nothing above it) is not applied
+      const double l = it.value();
+      double* yr = Y.data() + r * ncol;
+      for (Eigen::Index c = a; c < b; ++c) yr[c] -= yi[c] * l;
+      lo[static_cast<std::size_t>(r)] = std::min(lo[static_cast<std::size_t>(r)], a);
+      hi[static_cast<std::size_t>(r)] = std::max(hi[static_cast<std::size_t>(r)], b);
+    }
+  }
+  w.Z = Y;
+}
+
+}  // namespace
+
 template <int Dim>
 void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   // Z = A^-1 E (response of the grain's velocities to unit impulses at its slots; A^-1 -> M^-1
@@ -116,8 +159,7 @@ void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
       }
   }
   if (w.z_forward) {
-    w.Z = w.ldlt.permutationP() * w.Z;
-    w.ldlt.matrixL().solveInPlace(w.Z);
+    forward_substitute(w);
     G.noalias() = w.Z.transpose() * w.ldlt.vectorD().cwiseInverse().asDiagonal() * w.Z;
     return;
   }
