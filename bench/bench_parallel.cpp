@@ -23,6 +23,7 @@
 #include <iostream>
 #include <string>
 
+#include "mpmcd/core/openmp_env.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "mpmcd/parallel/distribute.hpp"
 #include "slice_300.hpp"
@@ -30,6 +31,7 @@
 using namespace mpmcd;
 
 int main(int argc, char** argv) {
+  apply_openmp_wait_policy(argv);  // as mpmcd: its spin count (may execute this again)
   std::string scheme_name = "partition", csv, trace;
   int threads = 1, warmup = 50, steps = 50, cpu = 0, every = 25, mirror = 0;
   double threshold = 0;

@@ -1,4 +1,5 @@
 #include "mpmcd/app/simulation.hpp"
+#include "mpmcd/core/openmp_env.hpp"
 
 #include <fmt/format.h>
 #include <omp.h>
@@ -125,9 +126,10 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
                                      restart, history_dir);
   log().info(
       "mpmcd {} ({}): {} grains, {} material points, grid {}x{} cells of {} m, {} rank(s) x {} "
-      "threads",
+      "threads ({})",
       kVersion, kGitHash, model_.grains.size(), model_.points.size(), model_.grid.cells()[0],
-      model_.grid.cells()[1], model_.grid.cell_size(), comm_.size(), omp_get_max_threads());
+      model_.grid.cells()[1], model_.grid.cell_size(), comm_.size(), omp_get_max_threads(),
+      openmp_wait_policy());
   if (restart) {
     dt_control_.restore(restart->dt, restart->good_since_cut);
     summary_.steps = restart->step;

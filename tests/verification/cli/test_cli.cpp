@@ -16,6 +16,7 @@
 
 #include "mpmcd/analysis/time_series.hpp"
 #include "mpmcd/checkpoint/checkpoint.hpp"
+#include "mpmcd/core/openmp_env.hpp"
 
 #include "../../support/cli_runner.hpp"
 
@@ -569,4 +570,28 @@ for f in counts["empty"]:
     EXPECT_NE(out.find("vtk read empty mpmcd_contacts_000000.vtu"), std::string::npos) << out;
   }
   std::printf("%s", out.c_str());
+}
+
+// The spin count mpmcd sets for libgomp unless the user chose a wait policy (core/openmp_env.hpp),
+// as the run's log line of ranks and threads reports it.
+TEST(Cli, SetsTheOpenMpSpinCountUnlessTheUserChoseAWaitPolicy) {
+  const auto first_line = [](const std::string& env) {
+    const fs::path dir = scratch("spin");
+    const std::string cmd = "env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT -u MPMCD_OPENMP_ENV_SET " +
+                            env + " " + std::string(MPMCD_BINARY) + " run " + example() +
+                            " -t 2 --stop-after 1 --overwrite -o " + dir.string() + " 2>&1";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf{};
+    std::string out;
+    while (pipe && fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+    if (pipe) pclose(pipe);
+    const auto at = out.find("rank(s) x");  // the run's first line (threads, wait policy)
+    return at == std::string::npos ? out : out.substr(at, out.find('\n', at) - at);
+  };
+  EXPECT_NE(first_line("").find(fmt::format("(GOMP_SPINCOUNT={})", mpmcd::kGompSpinCount)),
+            std::string::npos)
+      << first_line("");
+  EXPECT_NE(first_line("OMP_WAIT_POLICY=passive").find("(OMP_WAIT_POLICY=passive)"),
+            std::string::npos);
+  EXPECT_NE(first_line("GOMP_SPINCOUNT=77").find("(GOMP_SPINCOUNT=77)"), std::string::npos);
 }
