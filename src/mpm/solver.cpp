@@ -111,10 +111,10 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   grain_work_.resize(ng * parallel::kWorkPhases, 0.0);
   double owned_points = 0;
   for (std::size_t g : owned_) {
-    phase_work(g, 0) += kSetupWorkWeight * static_cast<double>(grains_[g].size());
+    phase_work(g, 0) += parallel::cost::kSetup * static_cast<double>(grains_[g].size());
     owned_points += static_cast<double>(grains_[g].size());
   }
-  if (dist) comm_->count_work(kP2gWorkWeight * owned_points);
+  if (dist) comm_->count_work(parallel::cost::kP2g * owned_points);
   if (collect_failure()) return stats;
   const bool contact = settings_.contact.enabled;
   if (contact && dist) {
@@ -125,7 +125,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     ScopedStage t(&timers_, "contact.detect");
     detect_contacts(dt);
     if (dist) {
-      comm_->count_work(kDetectItemWeight * detect_items_);
+      comm_->count_work(parallel::cost::kDetectItem * detect_items_);
       ScopedStage tc(&timers_, "contact.detect.comm");
       exchange_requests();
     } else {
@@ -227,7 +227,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         const points::Grain& gr = grains_[g];
         newton_solve(w, trial_, settings_, points_, gr, *laws_[gr.material], w.compliance(), dt,
                      reuse_factor(w, settings_));
-        const double u = kCgWorkWeight * w.cg_work;
+        const double u = parallel::cost::kCgWork * w.cg_work;
         phase_work(g, it) += u;
         units += u;
       }

@@ -152,7 +152,7 @@ void ImplicitSolver<Dim>::exchange_entries() {
   std::vector<char> dest(static_cast<std::size_t>(np));
   // Counted work (Comm::count_work): grain pairs tested above; node-in-box and wall tests, values
   // packed.
-  comm_->count_work(kPairTestWeight * static_cast<double>(owned_.size() * ng));
+  comm_->count_work(parallel::cost::kPairTest * static_cast<double>(owned_.size() * ng));
   double tests = 0, items = 0;
   for (std::size_t g : owned_) {
     const GrainWork& w = *work_[g];
@@ -206,7 +206,7 @@ void ImplicitSolver<Dim>::exchange_entries() {
       items += static_cast<double>(sel.size() + 2 * pts.size());
     }
   }
-  comm_->count_work(kBoxTestWeight * tests + kExchangeItemWeight * items);
+  comm_->count_work(parallel::cost::kBoxTest * tests + parallel::cost::kExchangeItem * items);
   auto in = comm_->exchange(out, neighbours_);
   // 4. Ghost grains: their sent nodes as a field of this rank (mass, mass gradient, points).
   for (auto& [r, b] : in) {
@@ -238,7 +238,8 @@ void ImplicitSolver<Dim>::exchange_entries() {
       w.v.assign(k, Vec<Dim>::Zero());
       w.P.assign(k, Vec<Dim>::Zero());
       w.mask.assign(k, 0);
-      comm_->count_work(kExchangeItemWeight * static_cast<double>(k + w.node_pts.size() + npts));
+      comm_->count_work(parallel::cost::kExchangeItem *
+                        static_cast<double>(k + w.node_pts.size() + npts));
     }
   }
   local_.clear();
@@ -259,7 +260,7 @@ void ImplicitSolver<Dim>::exchange_requests() {
     links_[r];
     out[r];
   }
-  comm_->count_work(kExchangeItemWeight * static_cast<double>(slot_ref_.size()));
+  comm_->count_work(parallel::cost::kExchangeItem * static_cast<double>(slot_ref_.size()));
   for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
     const auto [g, a] = slot_ref_[s];
     if (role_[g] != 2) continue;
@@ -289,7 +290,7 @@ void ImplicitSolver<Dim>::exchange_requests() {
       link.serve.emplace_back(g, a);
     }
   }
-  comm_->count_work(kExchangeItemWeight * static_cast<double>(link_sizes().first));
+  comm_->count_work(parallel::cost::kExchangeItem * static_cast<double>(link_sizes().first));
 }
 
 template <int Dim>
@@ -316,7 +317,7 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
       parallel::Buffer& b = out[r];
       for (const auto& [g, a] : link.serve) b.put(work_[g]->v[a]);
     }
-    comm_->count_work(kExchangeItemWeight * static_cast<double>(n_serve));
+    comm_->count_work(parallel::cost::kExchangeItem * static_cast<double>(n_serve));
     auto in = comm_->exchange(out, neighbours_);
     for (const auto& [r, link] : links_) {
       parallel::Buffer& b = in.at(r);
@@ -336,7 +337,7 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
   }
   std::vector<Vec<Dim>> old(problem_.contacts.size());
   for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
-  comm_->count_work(kExchangeItemWeight * (static_cast<double>(n_ask) + n_slots));
+  comm_->count_work(parallel::cost::kExchangeItem * (static_cast<double>(n_ask) + n_slots));
   // 3. Gauss-Seidel: each rank on its nodes' contacts (no slot is shared between ranks), the
   // error summed over ranks before every test (partition); all contacts on rank 0 (master).
   contact::GsResult r;
@@ -345,7 +346,7 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
     // test, two (the sweep and its error) for the others.
     double passes = 1;
     const contact::ErrorReduce reduce = [&](double& num, double& den) {
-      comm_->count_work(kContactPassWeight * passes *
+      comm_->count_work(parallel::cost::kContactPass * passes *
                         static_cast<double>(problem_.contacts.size()));
       passes = 2;
       ScopedStage tc(&timers_, "contact.solve.comm");
@@ -361,7 +362,7 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
     if (comm_->rank() == 0) {
       ScopedStage t(&timers_, "contact.gs");
       r = contact::solve_gauss_seidel(problem_, gs_settings());
-      comm_->count_work(kContactPassWeight * (1.0 + 2.0 * r.sweeps) *
+      comm_->count_work(parallel::cost::kContactPass * (1.0 + 2.0 * r.sweeps) *
                         static_cast<double>(problem_.contacts.size()));
     }
     ScopedStage tc(&timers_, "contact.solve.comm");
@@ -398,13 +399,14 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
         work_[slot_ref_[s].first]->P[slot_ref_[s].second] = slot_p[s];
       }
     }
-    comm_->count_work(kExchangeItemWeight * (static_cast<double>(old.size() + n_ask) + n_slots));
+    comm_->count_work(parallel::cost::kExchangeItem *
+                      (static_cast<double>(old.size() + n_ask) + n_slots));
     auto in = comm_->exchange(out, neighbours_);
     for (const auto& [rk, link] : links_) {
       parallel::Buffer& b = in.at(rk);
       for (const auto& [g, a] : link.serve) apply(g, a, take<Vec<Dim>>(b));
     }
-    comm_->count_work(kExchangeItemWeight * static_cast<double>(n_serve));
+    comm_->count_work(parallel::cost::kExchangeItem * static_cast<double>(n_serve));
     std::vector<double> v{num, den};
     comm_->sum(v);
     num = v[0];

@@ -17,6 +17,7 @@
 #include "mpmcd/mpm/grain_field.hpp"
 #include "mpmcd/mpm/settings.hpp"
 #include "mpmcd/parallel/comm.hpp"
+#include "mpmcd/parallel/cost_model.hpp"
 #include "mpmcd/parallel/partition.hpp"
 #include "mpmcd/points/point_set.hpp"
 
@@ -201,27 +202,6 @@ class ImplicitSolver {
   std::vector<double> grain_work_;
   // The work count of grain g in the phase of Newton iteration `iteration`.
   double& phase_work(std::size_t g, int iteration);
-  // Costs in evaluations of a point (82 ns each), measured on the 300-grain slice on one rank:
-  // P2G with the previous step's G2P (7.5 ms for 61k points), contact detection (8.3 ms), their
-  // sum (re-balancing), one CG iteration per matrix non-zero with the tangent assembly (6.5 ms
-  // for 1.67e6), one pass of Gauss-Seidel or of its error over a contact (2.9 ms for 61.8k).
-  static constexpr double kP2gWorkWeight = 1.5;
-  static constexpr double kDetectWorkWeight = 1.7;
-  static constexpr double kSetupWorkWeight = kP2gWorkWeight + kDetectWorkWeight;
-  // The pass weight is 0.57 by that benchmark; the traces of the distributed solve (partition
-  // and master, 2 ranks, 2026-11-21) give 1.35 times more between two error tests: 0.77.
-  static constexpr double kContactPassWeight = 0.77;
-  // One item of contact detection (a node field, a pair of fields, a pair of points in a gap).
-  // (8.3 ms for 145k items on one rank).
-  static constexpr double kDetectItemWeight = 0.7;
-  // The exchanges' bookkeeping, fitted on traces of the slice on 2 ranks (bench_parallel --trace,
-  // master scheme, where rank 1 examines and packs every contact node for rank 0; 100 ns per
-  // unit that day): one value packed or unpacked, a slot served, asked or updated, or a contact
-  // in the pass after the solve (5-20 ns); one node-in-box or node-to-wall test while choosing
-  // the nodes to send (50 ns); one overlap test of two grains' boxes (7 ns).
-  static constexpr double kExchangeItemWeight = 0.1;
-  static constexpr double kBoxTestWeight = 0.5;
-  static constexpr double kPairTestWeight = 0.07;
   // The Gauss-Seidel settings with this solver's timers (threaded sweeps, ThreadedRegion) and its
   // tuner (threads or one thread per sweep, by measured cost; kept from step to step).
   contact::GsSettings gs_settings() {
@@ -237,7 +217,6 @@ class ImplicitSolver {
   double detect_items_ = 0;
   // Per point: sum_i |F r_i|, a bound of its domain's extent along any direction [m].
   std::vector<double> point_reach_;
-  static constexpr double kCgWorkWeight = 0.048;
   double time_ = 0.0;
   double dt_ = 0.0;
   bool step_ready_ = false;
