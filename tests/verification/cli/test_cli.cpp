@@ -620,6 +620,47 @@ TEST(Cli, GrainOutputsAtSnapshotTimes) {
       EXPECT_GT(forces.rows(), 5u);
     }
   }
+  // `mpmcd analyze` on it: the fabric series and, at Φ = 0.7, the distributions of the snapshot
+  // nearest that Φ, whose counts are the grain-grain rows and the non-rattler grains it holds.
+  const Result a = run("analyze " + (dir / "out").string() + " --phi 0.7 --no-plots");
+  ASSERT_EQ(a.code, 0) << a.output;
+  const fs::path an = dir / "out" / "analysis";
+  const auto fabric = mpmcd::analysis::read_time_series((an / "fabric.csv").string());
+  EXPECT_EQ(fabric.rows(), series.rows());
+  EXPECT_NEAR(fabric.column("fabric_a").back(), series.column("fabric_a").back(), 1e-11);
+  const auto fdist = mpmcd::analysis::read_time_series((an / "force_distribution.csv").string());
+  const auto pdist = mpmcd::analysis::read_time_series((an / "pressure_distribution.csv").string());
+  ASSERT_GT(fdist.rows(), 0u);
+  const double t = fdist.column("time").front();
+  int snapshot = -1;
+  for (int k = 0; k < 3; ++k)
+    if (mpmcd::analysis::read_time_series(
+            (dir / "out" / fmt::format("compaction_grains_{:06d}.csv", k)).string())
+            .column("time")
+            .front() == t)
+      snapshot = k;
+  ASSERT_GE(snapshot, 0);
+  const auto forces = mpmcd::analysis::read_time_series(
+      (dir / "out" / fmt::format("compaction_forces_{:06d}.csv", snapshot)).string());
+  const auto grains = mpmcd::analysis::read_time_series(
+      (dir / "out" / fmt::format("compaction_grains_{:06d}.csv", snapshot)).string());
+  double pairs = 0, kept = 0, counted = 0, density = 0, mean = 0;
+  for (std::size_t c = 0; c < forces.rows(); ++c)
+    if (forces.column("a")[c] >= 0) {
+      ++pairs;
+      mean += forces.column("fn")[c];
+    }
+  for (std::size_t g = 0; g < grains.rows(); ++g) kept += grains.column("rattler")[g] == 0;
+  for (std::size_t b = 0; b < fdist.rows(); ++b) {
+    counted += fdist.column("count")[b];
+    density += fdist.column("density")[b] * (fdist.column("bin_hi")[b] - fdist.column("bin_lo")[b]);
+  }
+  EXPECT_EQ(counted, pairs);
+  EXPECT_NEAR(density, 1.0, 1e-12);  // every f/<f> within [0, 4] here
+  EXPECT_NEAR(fdist.column("mean").front(), mean / pairs, 1e-9 * mean / pairs);
+  double pcount = 0;
+  for (std::size_t b = 0; b < pdist.rows(); ++b) pcount += pdist.column("count")[b];
+  EXPECT_EQ(pcount, kept);
   // Bad value: exit 2 naming the file and the key, nothing written.
   text.replace(text.find("grains = true"), 13, "grains = \"yes\"");
   text.replace(text.find("folder = \"out\""), 14, "folder = \"bad\"");
