@@ -278,7 +278,9 @@ int analyze_command(const AnalyzeOptions& opt) {
                      for (const char* own :
                           {"compaction_fit.csv", "figure4.csv", "figure5.csv", "figure4.png",
                            "figure5.png", "pressure_law.csv", "phi_pressure.csv", "fabric.csv",
-                           "force_distribution.csv", "pressure_distribution.csv"})
+                           "force_distribution.csv", "pressure_distribution.csv",
+                           "pressure_law.png", "pressure_law.pdf", "fabric.png", "fabric.pdf",
+                           "distributions.png", "distributions.pdf"})
                        if (f == own || f == std::string(own) + ".tmp") return true;
                      return false;
                    }),
@@ -420,6 +422,17 @@ int analyze_command(const AnalyzeOptions& opt) {
     std::cout << "PNGs not written: " << cmd << " failed\n";
   else
     std::cout << fmt::format("wrote {}/figure4.png, figure5.png\n", out_dir);
+  // tools/plot_grains.py, next to plot_compaction.py: the pressure law, the fabric and the
+  // distributions (PNG and PDF).
+  const fs::path grains_script = fs::path(script).parent_path() / "plot_grains.py";
+  if (!fs::is_regular_file(grains_script)) return 0;
+  const std::string gcmd =
+      python + " " + shell_quote(grains_script.string()) + " " + shell_quote(out_dir);
+  if (std::system(gcmd.c_str()) != 0)
+    std::cout << "grain plots not written: " << gcmd << " failed\n";
+  else
+    std::cout << fmt::format("wrote {}/{}.png and .pdf\n", out_dir,
+                             grains ? "pressure_law, fabric, distributions" : "pressure_law");
   return 0;
 }
 
