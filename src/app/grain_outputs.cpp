@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "mpmcd/io/vtu.hpp"
 
 namespace mpmcd::app {
@@ -25,11 +27,10 @@ void write_grains_csv(const mpm::Model<2>& model, const GrainSnapshot& snap, dou
   std::vector<int> grain_contacts(snap.grains.size(), 0), wall_contacts(snap.grains.size(), 0);
   for (const auto& p : snap.pairs) {
     if (!p.in_contact) continue;
-    ++grain_contacts[static_cast<std::size_t>(p.b)];
-    if (p.a >= 0)
+    if (p.a >= 0) {
       ++grain_contacts[static_cast<std::size_t>(p.a)];
-    else {
-      --grain_contacts[static_cast<std::size_t>(p.b)];
+      ++grain_contacts[static_cast<std::size_t>(p.b)];
+    } else {
       ++wall_contacts[static_cast<std::size_t>(p.b)];
     }
   }
