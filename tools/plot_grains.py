@@ -62,7 +62,7 @@ def main():
                 ax.axhline(phi_max, color=c, lw=0.6, ls=":")
         ax.set_xlabel("P = −(σ̄xx + σ̄yy)/2 [kPa]")
         ax.set_ylabel("Φ")
-        ax.set_title("Solid fraction against pressure, Φ = Φmax − (Φmax − ΦJ) exp(−P/P0)")
+        ax.set_title("Φ(P) = Φmax − (Φmax − ΦJ) exp(−P/P0)")
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
         save(fig, folder, "pressure_law")
