@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace mpmcd::analysis {
@@ -170,6 +172,128 @@ std::optional<std::size_t> detect_jamming(std::span<const double> phi,
   while (first > 0 && jammed(first - 1)) --first;
   if (first == n) return std::nullopt;
   return first;
+}
+
+double pressure_law(double pressure, double phi_j, double phi_max, double p0) {
+  return phi_max - (phi_max - phi_j) * std::exp(-pressure / p0);  // exponential approach
+}
+
+namespace {
+
+// Best Φ_max for a fixed P0 (Φ - Φ_J e = Φ_max (1 - e), e = exp(-P/P0): linear least squares)
+// and the sum of squared residuals of Φ.
+std::pair<double, double> pressure_law_at(std::span<const double> p, std::span<const double> phi,
+                                          double phi_j, double p0) {
+  double num = 0, den = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double e = std::exp(-p[i] / p0);
+    num += (phi[i] - phi_j * e) * (1 - e);
+    den += (1 - e) * (1 - e);
+  }
+  const double phi_max = den > 0 ? num / den : phi_j;
+  double sse = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double r = phi[i] - pressure_law(p[i], phi_j, phi_max, p0);
+    sse += r * r;
+  }
+  return {phi_max, sse};
+}
+
+}  // namespace
+
+PressureLawFit fit_pressure_law(std::span<const double> p, std::span<const double> phi,
+                                double phi_j) {
+  if (p.size() != phi.size() || p.size() < 3)
+    throw std::invalid_argument("the pressure law needs at least 3 (P, Phi) points");
+  double p_max = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!std::isfinite(p[i]) || !std::isfinite(phi[i]))
+      throw std::invalid_argument("non-finite (P, Phi) point");
+    p_max = std::max(p_max, p[i]);
+  }
+  if (!(p_max > 0) || !std::isfinite(phi_j))
+    throw std::invalid_argument("the pressure law needs some P > 0 and a finite Phi_J");
+  // Scan of log10 P0 over [log10 P_max - 4, log10 P_max + 3], 10 values per decade.
+  const double lo = std::log10(p_max) - 4;
+  constexpr int kScan = 71;
+  const auto sse_at = [&](double log_p0) {
+    return pressure_law_at(p, phi, phi_j, std::pow(10.0, log_p0)).second;
+  };
+  int best = 0;
+  double best_sse = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < kScan; ++k) {
+    const double s = sse_at(lo + 0.1 * k);
+    if (s < best_sse) {
+      best_sse = s;
+      best = k;
+    }
+  }
+  // Golden-section search on the bracket of the best scan value.
+  double a = lo + 0.1 * std::max(best - 1, 0), b = lo + 0.1 * std::min(best + 1, kScan - 1);
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double c = b - g * (b - a), d = a + g * (b - a), fc = sse_at(c), fd = sse_at(d);
+  while (b - a > 1e-10 * std::max(1.0, std::fabs(a))) {
+    if (fc < fd) {
+      b = d;
+      d = c;
+      fd = fc;
+      c = b - g * (b - a);
+      fc = sse_at(c);
+    } else {
+      a = c;
+      c = d;
+      fc = fd;
+      d = a + g * (b - a);
+      fd = sse_at(d);
+    }
+  }
+  PressureLawFit fit;
+  fit.p0 = std::pow(10.0, 0.5 * (a + b));
+  auto [phi_max, sse] = pressure_law_at(p, phi, phi_j, fit.p0);
+  // J^T J and J^T r at (Φ_max, P0), J_i = (dΦ/dΦ_max, dΦ/dP0) = (1 - e, -(Φ_max - Φ_J) e P/P0²).
+  Eigen::Matrix2d jtj;
+  Eigen::Vector2d jtr;
+  const auto normal_equations = [&](double pm, double q) {
+    jtj.setZero();
+    jtr.setZero();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double e = std::exp(-p[i] / q);
+      const Eigen::Vector2d j(1 - e, -(pm - phi_j) * e * p[i] / (q * q));
+      jtj += j * j.transpose();
+      jtr += j * (phi[i] - pressure_law(p[i], phi_j, pm, q));
+    }
+  };
+  // Gauss-Newton polish from the search's point (a function-value search locates a minimum to
+  // about sqrt(machine epsilon) only): steps kept while the sum of squares decreases.
+  for (int it = 0; it < 50; ++it) {
+    normal_equations(phi_max, fit.p0);
+    if (!(std::fabs(jtj.determinant()) > 0)) break;
+    const Eigen::Vector2d step = jtj.ldlt().solve(jtr);
+    const double pm = phi_max + step[0], q = fit.p0 + step[1];
+    if (!(q > 0)) break;
+    double trial = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double r = phi[i] - pressure_law(p[i], phi_j, pm, q);
+      trial += r * r;
+    }
+    if (!(trial < sse)) break;
+    phi_max = pm;
+    fit.p0 = q;
+    sse = trial;
+  }
+  fit.phi_max = phi_max;
+  fit.points = p.size();
+  fit.determined = best > 0 && best < kScan - 1 && phi_max > phi_j && phi_max <= 1.0;
+  fit.rms = std::sqrt(sse / static_cast<double>(p.size()));
+  // Covariance s^2 (J^T J)^-1.
+  normal_equations(phi_max, fit.p0);
+  const double s2 = p.size() > 2 ? sse / static_cast<double>(p.size() - 2) : 0.0;
+  if (std::fabs(jtj.determinant()) > 0) {
+    const Eigen::Matrix2d cov = s2 * jtj.inverse();
+    fit.phi_max_error = std::sqrt(std::max(cov(0, 0), 0.0));
+    fit.p0_error = std::sqrt(std::max(cov(1, 1), 0.0));
+  }
+  return fit;
 }
 
 }  // namespace mpmcd::analysis

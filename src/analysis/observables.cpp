@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -203,45 +204,65 @@ Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, doub
 }
 
 std::vector<ContactImpulse> contact_impulses(const contact::Problem<2>& problem) {
+  return contact_impulses(problem, {});
+}
+
+std::vector<ContactImpulse> contact_impulses(
+    const contact::Problem<2>& problem, const std::function<Vec<2>(std::int64_t)>& node_position) {
   std::vector<ContactImpulse> out;
   out.reserve(problem.contacts.size());
   for (const auto& c : problem.contacts) {
     ContactImpulse ci;
+    const auto& sb = problem.slots[static_cast<std::size_t>(c.b)];
     ci.a = c.a >= 0 ? problem.slots[static_cast<std::size_t>(c.a)].grain : -1 - c.wall;
-    ci.b = problem.slots[static_cast<std::size_t>(c.b)].grain;
+    ci.b = sb.grain;
     ci.normal_impulse = c.impulse.dot(c.normal);  // impulse on B along the normal from A to B
+    ci.impulse = c.impulse;
+    ci.normal = c.normal;
+    if (node_position) ci.position = node_position(sb.node);
     out.push_back(ci);
   }
   return out;
 }
 
+std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulse> contacts,
+                                       std::int64_t n_grains) {
+  // Normal impulse summed per pair of bodies over all its contact nodes (walls: a < 0).
+  std::map<std::pair<std::int32_t, std::int32_t>, double> sums;
+  for (const auto& c : contacts) {
+    if (c.b < 0 || c.b >= n_grains || c.a >= n_grains || c.a == c.b) continue;
+    sums[{std::min(c.a, c.b), std::max(c.a, c.b)}] += c.normal_impulse;
+  }
+  std::vector<PairImpulse> out;
+  out.reserve(sums.size());
+  for (const auto& [key, p] : sums) out.push_back({key.first, key.second, p});
+  return out;
+}
+
+double contact_threshold(std::span<const PairImpulse> pairs, const CoordinationSettings& settings) {
+  double largest = 0;
+  for (const auto& p : pairs) largest = std::max(largest, p.normal_impulse);
+  return settings.relative_threshold * largest;
+}
+
 Coordination coordination(std::span<const ContactImpulse> contacts, std::int64_t n_grains,
                           const CoordinationSettings& settings) {
   Coordination out;
-  // Normal impulse summed per pair of bodies over all its contact nodes (walls: a < 0).
   const auto n = static_cast<std::size_t>(std::max<std::int64_t>(n_grains, 0));
-  std::map<std::pair<std::int32_t, std::int32_t>, double> pairs, walls;
-  for (const auto& c : contacts) {
-    if (c.b < 0 || c.b >= n_grains || c.a >= n_grains || c.a == c.b) continue;
-    if (c.a < 0)
-      walls[{c.a, c.b}] += c.normal_impulse;
-    else
-      pairs[{std::min(c.a, c.b), std::max(c.a, c.b)}] += c.normal_impulse;
-  }
-  double largest = 0;
-  for (const auto& [key, p] : pairs) largest = std::max(largest, p);
-  for (const auto& [key, p] : walls) largest = std::max(largest, p);
-  const double threshold = settings.relative_threshold * largest;
+  const auto pairs = pair_impulses(contacts, n_grains);
+  const double threshold = contact_threshold(pairs, settings);
   std::vector<std::pair<std::int32_t, std::int32_t>> edges;
-  for (const auto& [key, p] : pairs)
-    if (p > threshold && p > 0) edges.push_back(key);
-  out.all_pairs = static_cast<std::int64_t>(edges.size());
   std::vector<int> degree(n, 0);  // contacts per grain
-  for (const auto& [key, p] : walls)
-    if (p > threshold && p > 0) {
+  for (const auto& p : pairs) {
+    if (!(p.normal_impulse > threshold && p.normal_impulse > 0)) continue;
+    if (p.a >= 0) {
+      edges.emplace_back(p.a, p.b);
+    } else {
       ++out.wall_contacts;
-      if (settings.walls_hold_grains) ++degree[static_cast<std::size_t>(key.second)];
+      if (settings.walls_hold_grains) ++degree[static_cast<std::size_t>(p.b)];
     }
+  }
+  out.all_pairs = static_cast<std::int64_t>(edges.size());
 
   // Remove grains with fewer than two contacts until none is left (rattlers).
   for (const auto& [a, b] : edges) {
@@ -268,6 +289,7 @@ Coordination coordination(std::span<const ContactImpulse> contacts, std::int64_t
       }
     }
   }
+  out.kept.assign(kept.begin(), kept.end());
   out.grains = std::count(kept.begin(), kept.end(), 1);
   out.rattlers = static_cast<std::int64_t>(kept.size()) - out.grains;
   out.pairs = std::count(edge_alive.begin(), edge_alive.end(), 1);

@@ -10,6 +10,7 @@
 #include <limits>
 #include <set>
 
+#include "mpmcd/analysis/grains.hpp"
 #include "mpmcd/analysis/time_series.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/io/output_folder.hpp"
@@ -28,6 +29,7 @@ namespace {
 /// One run folder: its name, moduli, time series and analysis.
 struct Run {
   std::string folder;
+  std::string name;  // run name: <name>.csv and the grain files
   double lambda = 0, mu = 0;
   analysis::GrainModuli moduli;
   analysis::TimeSeries csv;
@@ -35,6 +37,8 @@ struct Run {
   std::optional<analysis::CompactionFit> fit;
   std::vector<std::size_t> fitted;  // rows fitted
   double identity_error = 0;        // max |ln(Vs/Vs0) - ln(Φ/Φ0) - ε| (paper eq. (9))
+  std::vector<double> pressure;  // P = -(σ̄xx + σ̄yy)/2 of the Love-Weber stress per row [Pa]
+  std::optional<analysis::PressureLawFit> law;  // Φ(P) beyond jamming
 };
 
 /// The run's name and the (λ, μ) of its grains from the input copy `input.toml`.
@@ -108,6 +112,117 @@ void analyse(Run& run, const analysis::JammingCriterion& criterion) {
   } catch (const std::invalid_argument& e) {
     std::cout << fmt::format("  fit failed: {}\n", e.what());
   }
+  // The pressure law Φ(P) on the same rows, P the mean pressure of the Love-Weber stress.
+  if (!run.csv.has("lw_sxx") || !run.csv.has("lw_syy")) return;
+  const auto& sxx = run.csv.column("lw_sxx");
+  const auto& syy = run.csv.column("lw_syy");
+  for (std::size_t i = 0; i < phi.size(); ++i)
+    run.pressure.push_back(-0.5 * (sxx[i] + syy[i]) + 0.0);  // + 0: no -0
+  std::vector<double> pp;
+  for (const std::size_t i : run.fitted) pp.push_back(run.pressure[i]);
+  try {
+    run.law = analysis::fit_pressure_law(pp, fp, phi_j);
+  } catch (const std::invalid_argument& e) {
+    std::cout << fmt::format("  pressure-law fit failed: {}\n", e.what());
+  }
+}
+
+std::string num(double v) {
+  return std::isfinite(v) ? fmt::format("{:.12g}", v) : "";
+}
+
+// The grain-scale snapshot files of a run, in snapshot order: (grains CSV, forces CSV, time).
+struct Snapshot {
+  fs::path grains, forces;
+  double time = 0;
+};
+
+std::vector<Snapshot> grain_snapshots(const Run& run) {
+  std::vector<Snapshot> out;
+  for (int k = 0;; ++k) {
+    Snapshot s;
+    s.grains = fs::path(run.folder) / fmt::format("{}_grains_{:06d}.csv", run.name, k);
+    s.forces = fs::path(run.folder) / fmt::format("{}_forces_{:06d}.csv", run.name, k);
+    if (!fs::is_regular_file(s.grains)) break;
+    const auto g = analysis::read_time_series(s.grains.string());
+    if (g.rows() == 0) continue;
+    s.time = g.column("time").front();
+    out.push_back(s);
+  }
+  return out;
+}
+
+// Histogram rows "run,phi_target,phi,time,mean,bin_lo,bin_hi,count,density" of values / mean.
+std::string distribution_rows(std::size_t r, double target, double phi, double time,
+                              const std::vector<double>& values) {
+  double mean = 0;
+  for (const double v : values) mean += v / static_cast<double>(values.size());
+  std::vector<double> ratio;
+  for (const double v : values) ratio.push_back(v / mean);
+  // f/<f> and P/<P> on [0, 4] in bins of 0.2 (docs/observables.md)
+  const auto h = analysis::histogram(ratio, 20, 0.0, 4.0);
+  std::string out;
+  for (std::size_t b = 0; b < h.counts.size(); ++b)
+    out += fmt::format("{},{:.6g},{:.12g},{:.12g},{:.12g},{:.6g},{:.6g},{},{:.12g}\n", r, target,
+                       phi, time, mean, h.edges[b], h.edges[b + 1], h.counts[b], h.density[b]);
+  return out;
+}
+
+// The fabric time series and the distributions at the solid fractions `targets` of a run with
+// grain-scale outputs; appends to the three CSV texts.
+void grain_analysis(const Run& run, std::size_t r, const std::vector<double>& targets,
+                    std::string& fabric, std::string& forces, std::string& pressures) {
+  if (!run.csv.has("fabric_a")) return;
+  const auto& phi = run.csv.column("phi");
+  const auto& time = run.csv.column("time");
+  const auto& z = run.csv.column("Z");
+  const auto& a = run.csv.column("fabric_a");
+  const auto& angle = run.csv.column("fabric_angle");
+  const auto& nc = run.csv.column("fabric_contacts");
+  const auto& gxx = run.csv.column("grain_sxx");
+  const auto& gyy = run.csv.column("grain_syy");
+  const auto& cxx = run.csv.column("contact_sxx");
+  const auto& cyy = run.csv.column("contact_syy");
+  for (std::size_t i = 0; i < phi.size(); ++i)
+    fabric += fmt::format("{},{},{},{},{},{},{},{},{}\n", r, num(time[i]), num(phi[i]), num(z[i]),
+                          num(a[i]), num(angle[i]), num(nc[i]), num(-0.5 * (gxx[i] + gyy[i]) + 0.0),
+                          num(-0.5 * (cxx[i] + cyy[i]) + 0.0));
+  if (targets.empty()) return;
+  const auto snaps = grain_snapshots(run);
+  if (snaps.empty()) {
+    std::cout << "  no grain snapshots (<name>_grains_<n>.csv): no distributions\n";
+    return;
+  }
+  const auto row_at = [&](double t) {  // the CSV row nearest in time
+    std::size_t best = 0;
+    for (std::size_t i = 0; i < time.size(); ++i)
+      if (std::fabs(time[i] - t) < std::fabs(time[best] - t)) best = i;
+    return best;
+  };
+  for (const double target : targets) {
+    std::size_t pick = 0;
+    for (std::size_t k = 0; k < snaps.size(); ++k)
+      if (std::fabs(phi[row_at(snaps[k].time)] - target) <
+          std::fabs(phi[row_at(snaps[pick].time)] - target))
+        pick = k;
+    const Snapshot& s = snaps[pick];
+    const double at = phi[row_at(s.time)];
+    std::vector<double> fn, pg;
+    if (fs::is_regular_file(s.forces)) {
+      const auto f = analysis::read_time_series(s.forces.string());
+      for (std::size_t c = 0; c < f.rows(); ++c)
+        if (f.column("a")[c] >= 0) fn.push_back(f.column("fn")[c]);  // grain-grain pairs
+    }
+    const auto g = analysis::read_time_series(s.grains.string());
+    for (std::size_t k = 0; k < g.rows(); ++k)
+      if (g.column("rattler")[k] == 0) pg.push_back(g.column("pressure")[k]);
+    std::cout << fmt::format(
+        "  distributions at Phi = {:.4f} (asked {:.4f}, t = {:.6g} s): {} grain contacts, {} "
+        "grains without rattlers\n",
+        at, target, s.time, fn.size(), pg.size());
+    if (!fn.empty()) forces += distribution_rows(r, target, at, s.time, fn);
+    if (!pg.empty()) pressures += distribution_rows(r, target, at, s.time, pg);
+  }
 }
 
 std::string shell_quote(const std::string& s) {
@@ -136,10 +251,6 @@ std::string find_plot_script() {
   return "";
 }
 
-std::string num(double v) {
-  return std::isfinite(v) ? fmt::format("{:.12g}", v) : "";
-}
-
 }  // namespace
 
 int analyze_command(const AnalyzeOptions& opt) {
@@ -148,9 +259,8 @@ int analyze_command(const AnalyzeOptions& opt) {
   for (const auto& folder : opt.folders) {
     Run run;
     run.folder = folder;
-    std::string name;
-    read_input_copy(run, name);
-    run.csv = analysis::read_time_series((fs::path(folder) / (name + ".csv")).string());
+    read_input_copy(run, run.name);
+    run.csv = analysis::read_time_series((fs::path(folder) / (run.name + ".csv")).string());
     analyse(run, opt.jamming);
     runs.push_back(std::move(run));
   }
@@ -165,8 +275,12 @@ int analyze_command(const AnalyzeOptions& opt) {
       out_dir,
       io::files_in(out_dir,
                    [](const std::string& f) {
-                     for (const char* own : {"compaction_fit.csv", "figure4.csv", "figure5.csv",
-                                             "figure4.png", "figure5.png"})
+                     for (const char* own :
+                          {"compaction_fit.csv", "figure4.csv", "figure5.csv", "figure4.png",
+                           "figure5.png", "pressure_law.csv", "phi_pressure.csv", "fabric.csv",
+                           "force_distribution.csv", "pressure_distribution.csv",
+                           "pressure_law.png", "pressure_law.pdf", "fabric.png", "fabric.pdf",
+                           "distributions.png", "distributions.pdf"})
                        if (f == own || f == std::string(own) + ".tmp") return true;
                      return false;
                    }),
@@ -179,6 +293,13 @@ int analyze_command(const AnalyzeOptions& opt) {
       "correlation,rms,converged,identity_error\n";
   std::string fig4 = "run,lambda,time,phi,eps,ln_Vs_Vs0\n";
   std::string fig5 = "run,lambda,phi,Z,sigma_over_Mp,model,fitted\n";
+  std::string law_csv = "run,phi_J,points,phi_max,phi_max_error,P0,P0_error,rms,determined\n";
+  std::string phi_p = "run,time,pressure,phi,model,fitted\n";
+  std::string fabric_csv =
+      "run,time,phi,Z,fabric_a,fabric_angle,fabric_contacts,grain_pressure,contact_pressure\n";
+  const std::string dist_header = "run,phi_target,phi,time,mean,bin_lo,bin_hi,count,density\n";
+  std::string force_csv = dist_header, pressure_csv = dist_header;
+  bool grains = false;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t r = 0; r < runs.size(); ++r) {
     const Run& run = runs[r];
@@ -220,6 +341,31 @@ int analyze_command(const AnalyzeOptions& opt) {
                            run.jam ? fmt::format("{}", *run.jam) : "", run.fitted.size(), num(f.c1),
                            num(f.c1_error), num(f.c2), num(f.c2_error), num(f.correlation),
                            num(f.rms), run.fit && f.converged ? 1 : 0, num(run.identity_error));
+    if (run.law)
+      std::cout << fmt::format(
+          "  pressure law Phi = Phi_max - (Phi_max - Phi_J) exp(-P/P0): Phi_max = {:.6g} +/- "
+          "{:.2g}, P0 = {:.6g} +/- {:.2g} Pa, {} points, RMS residual {:.3g} (of Phi){}\n",
+          run.law->phi_max, run.law->phi_max_error, run.law->p0, run.law->p0_error, run.law->points,
+          run.law->rms,
+          run.law->determined ? ""
+                              : "; NOT determined: the data do not approach a maximum in (Phi_J, "
+                                "1] (P0 at the end of the scan or Phi_max out of range)");
+    if (run.law)
+      law_csv +=
+          fmt::format("{},{},{},{},{},{},{},{},{}\n", r, num(phi[*run.jam]), run.law->points,
+                      num(run.law->phi_max), num(run.law->phi_max_error), num(run.law->p0),
+                      num(run.law->p0_error), num(run.law->rms), run.law->determined ? 1 : 0);
+    for (std::size_t i = 0; i < run.pressure.size(); ++i) {
+      const bool beyond = run.law && run.jam && i >= *run.jam;
+      const double m = beyond ? analysis::pressure_law(run.pressure[i], phi[*run.jam],
+                                                       run.law->phi_max, run.law->p0)
+                              : nan;
+      const bool fitted = beyond && phi[i] > phi[*run.jam];
+      phi_p += fmt::format("{},{},{},{},{},{}\n", r, num(time[i]), num(run.pressure[i]),
+                           num(phi[i]), num(m), fitted ? 1 : 0);
+    }
+    grains = grains || run.csv.has("fabric_a");
+    grain_analysis(run, r, opt.distribution_phi, fabric_csv, force_csv, pressure_csv);
     for (std::size_t i = 0; i < phi.size(); ++i) {
       fig4 += fmt::format("{},{},{},{},{},{}\n", r, num(run.lambda), num(time[i]), num(phi[i]),
                           num(eps[i]), num(lnvs[i]));
@@ -234,7 +380,22 @@ int analyze_command(const AnalyzeOptions& opt) {
   io::write_file_atomic((fs::path(out_dir) / "compaction_fit.csv").string(), fit_csv);
   io::write_file_atomic((fs::path(out_dir) / "figure4.csv").string(), fig4);
   io::write_file_atomic((fs::path(out_dir) / "figure5.csv").string(), fig5);
-  std::cout << fmt::format("wrote {}/compaction_fit.csv, figure4.csv, figure5.csv\n", out_dir);
+  io::write_file_atomic((fs::path(out_dir) / "pressure_law.csv").string(), law_csv);
+  io::write_file_atomic((fs::path(out_dir) / "phi_pressure.csv").string(), phi_p);
+  std::cout << fmt::format(
+      "wrote {}/compaction_fit.csv, figure4.csv, figure5.csv, pressure_law.csv, phi_pressure.csv\n",
+      out_dir);
+  if (grains) {
+    io::write_file_atomic((fs::path(out_dir) / "fabric.csv").string(), fabric_csv);
+    std::cout << fmt::format("wrote {}/fabric.csv\n", out_dir);
+    if (!opt.distribution_phi.empty()) {
+      io::write_file_atomic((fs::path(out_dir) / "force_distribution.csv").string(), force_csv);
+      io::write_file_atomic((fs::path(out_dir) / "pressure_distribution.csv").string(),
+                            pressure_csv);
+      std::cout << fmt::format("wrote {}/force_distribution.csv, pressure_distribution.csv\n",
+                               out_dir);
+    }
+  }
 
   if (!opt.plots) return 0;
   const std::string script = find_plot_script();
@@ -261,6 +422,17 @@ int analyze_command(const AnalyzeOptions& opt) {
     std::cout << "PNGs not written: " << cmd << " failed\n";
   else
     std::cout << fmt::format("wrote {}/figure4.png, figure5.png\n", out_dir);
+  // tools/plot_grains.py, next to plot_compaction.py: the pressure law, the fabric and the
+  // distributions (PNG and PDF).
+  const fs::path grains_script = fs::path(script).parent_path() / "plot_grains.py";
+  if (!fs::is_regular_file(grains_script)) return 0;
+  const std::string gcmd =
+      python + " " + shell_quote(grains_script.string()) + " " + shell_quote(out_dir);
+  if (std::system(gcmd.c_str()) != 0)
+    std::cout << "grain plots not written: " << gcmd << " failed\n";
+  else
+    std::cout << fmt::format("wrote {}/{}.png and .pdf\n", out_dir,
+                             grains ? "pressure_law, fabric, distributions" : "pressure_law");
   return 0;
 }
 

@@ -99,6 +99,11 @@ int run_cli(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   analyze->add_option("--jam-z", analyze_opt.jamming.min_z, "jammed: also Z at least this")
       ->check(CLI::NonNegativeNumber);
+  analyze
+      ->add_option("--phi", analyze_opt.distribution_phi,
+                   "solid fractions of the force and grain-pressure distributions (runs with "
+                   "[output] grains)")
+      ->check(CLI::Range(0.0, 1.0));
   bool analyze_no_plots = false;
   analyze->add_flag("--no-plots", analyze_no_plots, "write the CSV files only");
   analyze->add_flag("--overwrite", analyze_opt.overwrite,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <set>
 
+#include "mpmcd/app/grain_outputs.hpp"
 #include "mpmcd/app/model_builder.hpp"
 #include "mpmcd/core/log.hpp"
 
@@ -80,6 +81,7 @@ std::string CompactionObserver::csv_header() const {
     h += ",lw_sxx,lw_syy,lw_sxy,phi_geometric,overlap_over_Vs,outside_over_Vs,pore_diameter";
   }  // without a box: Vs is the `volume` column already
   if (contact_) h += ",Z,Z_pairs,Z_grains,rattlers";
+  if (config_.output.grains) h += grain_csv_header(contact_);
   return h;
 }
 
@@ -109,6 +111,11 @@ std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm
   if (contact_) {
     const auto z = analysis::coordination(analysis::contact_impulses(problem), grains_);
     out += fmt::format(",{:.17g},{},{},{}", z.z, z.pairs, z.grains, z.rattlers);
+  }
+  if (config_.output.grains) {  // V: the box's area, else the grains' (docs/observables.md)
+    const GrainSnapshot snap = grain_snapshot(model, problem, false);
+    const double volume = box_ ? analysis::box_at(walls_, *box_, t).area() : grain_area(model);
+    out += grain_csv_fields(snap, volume, contact_);
   }
   return out;
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "mpmcd/app/grain_outputs.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/output_folder.hpp"
 #include "mpmcd/version.hpp"
@@ -79,7 +80,9 @@ void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& pb,
     normal[3 * i + 1] = c.normal[1];
     pn[i] = c.impulse.dot(c.normal);
     pt[i] = c.impulse[1] * c.normal[0] - c.impulse[0] * c.normal[1];  // along t = e_z x n
-    const Vec<2> f = c.impulse * inv_dt;  // the contact's force on body b [N/m]
+    // The contact's force on body b [N/m], P/dt as contact::impulse_force but multiplied by 1/dt:
+    // its quotient differs in the last bit, and these files stay as they were written before.
+    const Vec<2> f = c.impulse * inv_dt;
     force[3 * i] = f[0];
     force[3 * i + 1] = f[1];
     gap[i] = c.gap;
@@ -152,7 +155,8 @@ void Outputs::copy_history(const std::string& from, const checkpoint::State& res
   const std::string& name = cfg_.simulation.name;
   std::vector<std::string> files{name + ".csv"};
   for (std::size_t k = 0; k < restart.vtu_times.size(); ++k)
-    for (const char* f : {"{}_{:06d}.vtu", "{}_contacts_{:06d}.vtu", "{}_pairs_{:06d}.csv"})
+    for (const char* f : {"{}_{:06d}.vtu", "{}_contacts_{:06d}.vtu", "{}_pairs_{:06d}.csv",
+                          "{}_grains_{:06d}.csv", "{}_forces_{:06d}.csv"})
       files.push_back(fmt::format(fmt::runtime(f), name, k));
   int copied = 0;
   for (const auto& f : files) {
@@ -200,7 +204,23 @@ void Outputs::csv_row(std::int64_t step, double t, double dt, const mpm::StepSta
 
 void Outputs::vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
                   const contact::Problem<2>& problem, double t) {
-  if (!pvd_) return;
+  if (cfg_.output.grains) {  // grain-scale files at every snapshot time, with or without VTU
+    const GrainSnapshot snap = grain_snapshot(model, problem);
+    const std::string gname = fmt::format("{}_grains_{:06d}.csv", cfg_.simulation.name, vtu_count_);
+    write_grains_csv(model, snap, t, (fs::path(dir_) / gname).string());
+    if (solver.settings().contact.enabled) {
+      const std::string fname =
+          fmt::format("{}_forces_{:06d}.csv", cfg_.simulation.name, vtu_count_);
+      write_contact_forces_csv(snap, t, (fs::path(dir_) / fname).string());
+    }
+  }
+  if (!pvd_) {
+    if (cfg_.output.grains) {  // the snapshot index still counts the grain files
+      vtu_times_.push_back(t);
+      ++vtu_count_;
+    }
+    return;
+  }
   const std::string name = fmt::format("{}_{:06d}.vtu", cfg_.simulation.name, vtu_count_);
   write_points_vtu(model, (fs::path(dir_) / name).string());
   if (solver.settings().contact.enabled) {

@@ -29,7 +29,8 @@ fs::path checkpoint_folder(const std::string& path) {
 std::vector<std::string> run_files(const std::string& folder, const std::string& name) {
   const std::regex own("(input\\.toml|" + io::regex_escape(name) +
                        "(\\.csv|\\.pvd|_contacts\\.pvd|_[0-9]{6}\\.vtu|_contacts_[0-9]{6}\\.vtu|"
-                       "_pairs_[0-9]{6}\\.csv|_checkpoint_[0-9]{9}\\.h5|_last_good\\.vtu|"
+                       "_pairs_[0-9]{6}\\.csv|_grains_[0-9]{6}\\.csv|_forces_[0-9]{6}\\.csv|"
+                       "_checkpoint_[0-9]{9}\\.h5|_last_good\\.vtu|"
                        "_timers\\.csv))(\\.tmp)?");
   return io::files_in(folder, [&](const std::string& f) { return std::regex_match(f, own); });
 }

@@ -424,6 +424,12 @@ Schema build_schema() {
        KeySpec::number("progress_interval", &OutputSection::progress_interval, "s",
                        "wall time between progress lines")
            .greater_than(0.0)
+           .default_of_member(),
+       KeySpec::boolean("grains", &OutputSection::grains,
+                        "grain-scale outputs: `<name>_grains_<n>.csv` (per-grain stress, shape, "
+                        "contacts) and `<name>_forces_<n>.csv` (contact forces per pair) at every "
+                        "snapshot time (vtu_interval), fabric and stress columns in the CSV "
+                        "(docs/observables.md)")
            .default_of_member()});
 
   s.add_table(

@@ -330,7 +330,8 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     if (c.impulse.dot(c.normal) > 0) ++stats.active_contacts;
     if (c.a < 0) {
       const std::size_t g = static_cast<std::size_t>(problem_.slots[c.b].grain);
-      for (int d = 0; d < Dim; ++d) wall_f[(g * nw + c.wall) * Dim + d] -= c.impulse[d] / dt;
+      const Vec<Dim> f = contact::impulse_force<Dim>(c.impulse, dt);  // force on the grain
+      for (int d = 0; d < Dim; ++d) wall_f[(g * nw + c.wall) * Dim + d] -= f[d];
     }
     const std::int32_t a = c.a < 0 ? -1 - c.wall : problem_.slots[c.a].grain;
     previous_.push_back({slot_key_[c.b], a, problem_.slots[c.b].grain, c.impulse});

@@ -55,4 +55,31 @@ std::optional<std::size_t> detect_jamming(std::span<const double> phi,
                                           std::span<const double> z,
                                           const JammingCriterion& criterion = {});
 
+/// Exponential approach of the solid fraction to Φ_max under the pressure P [Pa] (the compaction
+/// law of the isotropic compactions of soft grains, Cantor et al. 2020, Cárdenas-Barrantes et al.
+/// 2021, in its exponential form; docs/observables.md): Φ(P) = Φ_max - (Φ_max - Φ_J) exp(-P/P0)
+/// [-], Φ_J the solid fraction at jamming (P = 0), P0 > 0 [Pa].
+double pressure_law(double pressure, double phi_j, double phi_max, double p0);
+
+/// Result of fitting the pressure law.
+struct PressureLawFit {
+  double phi_max = 0;        ///< fitted Φ_max [-]
+  double p0 = 0;             ///< fitted P0 [Pa]
+  double phi_max_error = 0;  ///< standard error of Φ_max from s^2 (J^T J)^-1 [-]
+  double p0_error = 0;       ///< standard error of P0 [Pa]
+  double rms = 0;            ///< RMS residual of Φ [-]
+  std::size_t points = 0;    ///< data points fitted [-]
+  /// The data determine the law: the best P0 of the scan is inside it (not at either end: at
+  /// the upper end the data are still linear in P, far from Φ_max) and Φ_J < Φ_max <= 1 [-].
+  bool determined = false;
+};
+
+/// Fits (Φ_max, P0) of pressure_law with Φ_J given to (P, Φ) by least squares: for a fixed P0 the
+/// law is linear in Φ_max (closed form), so the sum of squares is minimised over log P0 by a scan
+/// (10 values per decade from 1e-4 to 1e3 times the largest P) refined by golden-section search
+/// to a relative 1e-10 and polished by Gauss-Newton on (Φ_max, P0). Needs at least 3 points with
+/// finite values and some P > 0; throws std::invalid_argument otherwise.
+PressureLawFit fit_pressure_law(std::span<const double> pressure, std::span<const double> phi,
+                                double phi_j);
+
 }  // namespace mpmcd::analysis

@@ -5,6 +5,7 @@
 /// network and the volume-averaged (Love-Weber) stress of the grains. Pure functions on plain data
 /// (2D).
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
@@ -100,16 +101,23 @@ struct Coverage {
 Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, double pixel,
                          std::int64_t max_pixels = std::int64_t{1} << 24);
 
-/// One grid-node contact reduced to what Z needs.
+/// One grid-node contact reduced to what Z and the contact forces need.
 struct ContactImpulse {
-  std::int32_t a = -1;        ///< grain A, or -1 - k for wall k [-]
-  std::int32_t b = -1;        ///< grain B [-]
-  double normal_impulse = 0;  ///< P·n, positive in compression [N s/m]
+  std::int32_t a = -1;               ///< grain A, or -1 - k for wall k [-]
+  std::int32_t b = -1;               ///< grain B [-]
+  double normal_impulse = 0;         ///< P·n, positive in compression [N s/m]
+  Vec<2> impulse = Vec<2>::Zero();   ///< P, impulse of A on B over the step [N s/m]
+  Vec<2> normal = Vec<2>::Zero();    ///< unit normal from A to B [-]
+  Vec<2> position = Vec<2>::Zero();  ///< position of the contact's grid node [m]
 };
 
-/// The contacts of a solved contact problem: grains of the two slots (a = -1 - k for wall k) and
-/// P·n.
+/// The contacts of a solved contact problem: grains of the two slots (a = -1 - k for wall k),
+/// P·n, P and n (position left 0).
 std::vector<ContactImpulse> contact_impulses(const contact::Problem<2>& problem);
+
+/// The same with each contact's position: node_position(slot node index) [m].
+std::vector<ContactImpulse> contact_impulses(
+    const contact::Problem<2>& problem, const std::function<Vec<2>(std::int64_t)>& node_position);
 
 /// Settings of the coordination number.
 struct CoordinationSettings {
@@ -122,6 +130,23 @@ struct CoordinationSettings {
   bool walls_hold_grains = true;
 };
 
+/// The normal impulse of one pair of bodies, summed over its grid-node contacts.
+struct PairImpulse {
+  std::int32_t a = -1;        ///< body A: a grain, or -1 - k for wall k (a < b) [-]
+  std::int32_t b = -1;        ///< grain B [-]
+  double normal_impulse = 0;  ///< Σ P·n over the pair's contacts [N s/m]
+};
+
+/// Normal impulses summed per pair of bodies (grains (min, max), walls (-1 - k, grain)), sorted
+/// by (a, b); contacts naming a grain outside [0, n_grains) or a grain with itself are skipped.
+std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulse> contacts,
+                                       std::int64_t n_grains);
+
+/// The summed normal impulse above which a pair is in contact: settings.relative_threshold times
+/// the largest of any pair (grain-grain or grain-wall) [N s/m]; a pair is in contact when its
+/// sum exceeds this and 0.
+double contact_threshold(std::span<const PairImpulse> pairs, const CoordinationSettings& settings);
+
 /// Coordination of the grain contact network.
 struct Coordination {
   double z = 0;                    ///< Z = 2 N_pairs / N_grains over the non-rattlers [-]
@@ -130,6 +155,7 @@ struct Coordination {
   std::int64_t rattlers = 0;       ///< grains removed (fewer than two contacts) [-]
   std::int64_t all_pairs = 0;      ///< grain pairs in contact before removing rattlers [-]
   std::int64_t wall_contacts = 0;  ///< grain-wall pairs in contact (not counted in Z) [-]
+  std::vector<std::uint8_t> kept;  ///< per grain: 1 if kept, 0 if removed as a rattler [-]
 };
 
 /// Coordination number Z (docs/observables.md): contact impulses summed per pair of bodies (all

@@ -22,7 +22,8 @@ class CompactionObserver {
   CompactionObserver(const io::Config& config, const mpm::Model<2>& model);
 
   /// The extra CSV header, starting with a comma: the box columns if the walls form a box, the
-  /// Z columns if contact is on ("" if neither, so runs without walls keep their columns).
+  /// Z columns if contact is on ("" if neither, so runs without walls keep their columns), and
+  /// with `[output] grains` the grain-scale columns (grain_csv_header).
   std::string csv_header() const;
 
   /// The extra CSV fields of the committed state at time t [s], starting with a comma; `step` is

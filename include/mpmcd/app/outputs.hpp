@@ -50,7 +50,8 @@ class Outputs {
   void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& stats,
                const mpm::Diagnostics<2>& d, const std::string& extra);
   /// Writes the snapshot of time t [s]: the points, and with contact the contacts of `problem`
-  /// and the per-pair forces; adds them to the series.
+  /// and the per-pair forces; adds them to the series. With `[output] grains`, also the
+  /// per-grain and contact-force CSVs (grain_outputs.hpp), even when `[output] vtu` is off.
   void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
            const contact::Problem<2>& problem, double t);
   /// Writes `<name>_last_good.vtu` of the points of `model`; returns its path.

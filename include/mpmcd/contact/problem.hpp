@@ -97,6 +97,15 @@ Vec<Dim> local_solution(const Vec<Dim>& u_free, double w, const Vec<Dim>& n, dou
   return local_solution<Dim>(u_free, Mat<Dim>(w * Mat<Dim>::Identity()), n, gap_over_dt, mu);
 }
 
+/// Mean force of a contact over the step of length dt [s] from its impulse P [N s] (2D: N s/m):
+/// f = P / dt [N] (2D: N/m), the impulses being integrals of the force over the step (method.md
+/// §4); zero when dt <= 0 (no step solved yet). The one place a force is made of an impulse.
+template <int Dim>
+Vec<Dim> impulse_force(const Vec<Dim>& impulse, double dt) {
+  if (!(dt > 0)) return Vec<Dim>::Zero();
+  return impulse / dt;
+}
+
 /// Net impulse on each slot, in contact order: sum of the impulses of the contacts where it is B,
 /// minus those where it is A [N s] (2D: N s/m).
 template <int Dim>

@@ -154,6 +154,9 @@ struct OutputSection {
   double csv_interval = 0.0;       ///< simulated time between CSV rows [s], 0 = every step
   bool vtu = true;                 ///< write VTU/PVD files [-]
   double progress_interval = 2.0;  ///< wall time between progress lines [s]
+  /// Grain-scale outputs: per-grain and contact-force CSVs at snapshot times, fabric and stress
+  /// columns in the CSV time series (docs/observables.md) [-].
+  bool grains = false;
 };
 
 /// [checkpoint]: when to write restart files (docs/robustness.md). A checkpoint is also written

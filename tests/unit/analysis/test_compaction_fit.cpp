@@ -132,3 +132,35 @@ TEST(Jamming, DetectedAfterTheLastUnjammedRow) {
   y.back() = 0.0;
   EXPECT_FALSE(detect_jamming(phi, y, z).has_value());
 }
+
+// The pressure law Φ(P) = Φ_max - (Φ_max - Φ_J) exp(-P/P0) fitted with Φ_J given: exact data
+// come back to round-off; data with Gaussian noise of 1e-4 in Φ stay within 3 standard errors.
+TEST(PressureLaw, RecoversPhiMaxAndP0) {
+  const double phi_j = 0.80, phi_max = 0.985, p0 = 2.0e5;
+  std::vector<double> p, phi;
+  for (int i = 1; i <= 40; ++i) {
+    p.push_back(1e6 * i / 40.0);
+    phi.push_back(pressure_law(p.back(), phi_j, phi_max, p0));
+  }
+  EXPECT_DOUBLE_EQ(pressure_law(0.0, phi_j, phi_max, p0), phi_j);
+  const auto exact = fit_pressure_law(p, phi, phi_j);
+  EXPECT_NEAR(exact.phi_max, phi_max, 1e-9);
+  EXPECT_NEAR(exact.p0 / p0, 1.0, 1e-7);
+  EXPECT_LT(exact.rms, 1e-12);
+  EXPECT_TRUE(exact.determined);
+  // Data still linear in P (P0 far beyond the pressures): Φ_max is not determined.
+  std::vector<double> linear;
+  for (double v : p) linear.push_back(phi_j + 1e-8 * v);
+  EXPECT_FALSE(fit_pressure_law(p, linear, phi_j).determined);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 1e-4);
+  std::vector<double> noisy = phi;
+  for (double& v : noisy) v += noise(rng);
+  const auto fit = fit_pressure_law(p, noisy, phi_j);
+  std::printf("  noisy: Phi_max %.6f +/- %.1e, P0 %.4g +/- %.2g Pa\n", fit.phi_max,
+              fit.phi_max_error, fit.p0, fit.p0_error);
+  EXPECT_LT(std::fabs(fit.phi_max - phi_max), 3 * fit.phi_max_error);
+  EXPECT_LT(std::fabs(fit.p0 - p0), 3 * fit.p0_error);
+  EXPECT_THROW(fit_pressure_law(std::vector<double>{1.0, 2.0}, std::vector<double>{0.8, 0.9}, 0.8),
+               std::invalid_argument);
+}

@@ -595,3 +595,104 @@ TEST(Cli, SetsTheOpenMpSpinCountUnlessTheUserChoseAWaitPolicy) {
             std::string::npos);
   EXPECT_NE(first_line("GOMP_SPINCOUNT=77").find("(GOMP_SPINCOUNT=77)"), std::string::npos);
 }
+
+// Issue 19: `[output] grains = true` writes, at every snapshot time, the per-grain CSV and the
+// contact-force CSV (docs/observables.md, "Grain-scale outputs"), consistent with the CSV time
+// series of the same instant; a bad value of the key is refused with exit 2.
+TEST(Cli, GrainOutputsAtSnapshotTimes) {
+  const fs::path dir = scratch("grains");
+  const fs::path src = fs::path(MPMCD_SOURCE_DIR) / "tests" / "verification" / "compaction";
+  fs::copy_file(src / "packing.csv", dir / "packing.csv");
+  std::string text = read(src / "compaction.toml");
+  text.replace(text.find("end_time = 4e-4"), 15, "end_time = 2e-4");
+  text.replace(text.find("vtu_interval = 2e-5"), 19, "vtu_interval = 1e-4\ngrains = true");
+  std::ofstream(dir / "grains.toml") << text;
+  const Result r = run("run -q -t 1 " + (dir / "grains.toml").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto series = mpmcd::analysis::read_time_series((dir / "out" / "compaction.csv").string());
+  for (const char* c : {"stress_volume", "grain_syy", "contact_syy", "fabric_a", "fabric_contacts"})
+    EXPECT_TRUE(series.has(c)) << c;
+  const auto& time = series.column("time");
+  for (int k = 0; k < 3; ++k) {  // t = 0, 1e-4, 2e-4 s
+    const auto grains = mpmcd::analysis::read_time_series(
+        (dir / "out" / fmt::format("compaction_grains_{:06d}.csv", k)).string());
+    const auto forces = mpmcd::analysis::read_time_series(
+        (dir / "out" / fmt::format("compaction_forces_{:06d}.csv", k)).string());
+    ASSERT_EQ(grains.rows(), 9u);
+    const double t = grains.column("time").front();
+    const auto row = static_cast<std::size_t>(
+        std::min_element(time.begin(), time.end(),
+                         [&](double a, double b) { return std::abs(a - t) < std::abs(b - t); }) -
+        time.begin());
+    ASSERT_NEAR(time[row], t, 1e-12);
+    // The grains' areas sum to Vs, their stresses to the Love-Weber stress of the row.
+    double vs = 0, syy = 0;
+    for (std::size_t g = 0; g < 9; ++g) {
+      vs += grains.column("area")[g];
+      syy += grains.column("area")[g] * grains.column("syy")[g];
+      EXPECT_NEAR(grains.column("circularity")[g], 1.0, 0.05);
+    }
+    EXPECT_NEAR(vs / series.column("Vs")[row], 1.0, 1e-11);
+    syy /= series.column("box_area")[row];
+    EXPECT_NEAR(syy, series.column("lw_syy")[row], 1e-10 * std::abs(series.column("lw_syy")[row]));
+    // The rows of the bottom wall (body -1) carry the force of the series' wall column.
+    double bottom = 0;
+    for (std::size_t c = 0; c < forces.rows(); ++c)
+      if (forces.column("a")[c] == -1) bottom += forces.column("fy")[c];
+    const double fy = series.column("wall_bottom_fy")[row];
+    EXPECT_NEAR(bottom, -fy, 1e-9 * std::abs(fy) + 1e-12) << "snapshot " << k;
+    if (k == 2) {
+      EXPECT_GT(forces.rows(), 5u);
+    }
+  }
+  // `mpmcd analyze` on it: the fabric series and, at Φ = 0.7, the distributions of the snapshot
+  // nearest that Φ, whose counts are the grain-grain rows and the non-rattler grains it holds.
+  const Result a = run("analyze " + (dir / "out").string() + " --phi 0.7 --no-plots");
+  ASSERT_EQ(a.code, 0) << a.output;
+  const fs::path an = dir / "out" / "analysis";
+  const auto fabric = mpmcd::analysis::read_time_series((an / "fabric.csv").string());
+  EXPECT_EQ(fabric.rows(), series.rows());
+  EXPECT_NEAR(fabric.column("fabric_a").back(), series.column("fabric_a").back(), 1e-11);
+  const auto fdist = mpmcd::analysis::read_time_series((an / "force_distribution.csv").string());
+  const auto pdist = mpmcd::analysis::read_time_series((an / "pressure_distribution.csv").string());
+  ASSERT_GT(fdist.rows(), 0u);
+  const double t = fdist.column("time").front();
+  int snapshot = -1;
+  for (int k = 0; k < 3; ++k)
+    if (mpmcd::analysis::read_time_series(
+            (dir / "out" / fmt::format("compaction_grains_{:06d}.csv", k)).string())
+            .column("time")
+            .front() == t)
+      snapshot = k;
+  ASSERT_GE(snapshot, 0);
+  const auto forces = mpmcd::analysis::read_time_series(
+      (dir / "out" / fmt::format("compaction_forces_{:06d}.csv", snapshot)).string());
+  const auto grains = mpmcd::analysis::read_time_series(
+      (dir / "out" / fmt::format("compaction_grains_{:06d}.csv", snapshot)).string());
+  double pairs = 0, kept = 0, counted = 0, density = 0, mean = 0;
+  for (std::size_t c = 0; c < forces.rows(); ++c)
+    if (forces.column("a")[c] >= 0) {
+      ++pairs;
+      mean += forces.column("fn")[c];
+    }
+  for (std::size_t g = 0; g < grains.rows(); ++g) kept += grains.column("rattler")[g] == 0;
+  for (std::size_t b = 0; b < fdist.rows(); ++b) {
+    counted += fdist.column("count")[b];
+    density += fdist.column("density")[b] * (fdist.column("bin_hi")[b] - fdist.column("bin_lo")[b]);
+  }
+  EXPECT_EQ(counted, pairs);
+  EXPECT_NEAR(density, 1.0, 1e-12);  // every f/<f> within [0, 4] here
+  EXPECT_NEAR(fdist.column("mean").front(), mean / pairs, 1e-9 * mean / pairs);
+  double pcount = 0;
+  for (std::size_t b = 0; b < pdist.rows(); ++b) pcount += pdist.column("count")[b];
+  EXPECT_EQ(pcount, kept);
+  // Bad value: exit 2 naming the file and the key, nothing written.
+  text.replace(text.find("grains = true"), 13, "grains = \"yes\"");
+  text.replace(text.find("folder = \"out\""), 14, "folder = \"bad\"");
+  std::ofstream(dir / "bad.toml") << text;
+  const Result b = run("run -q " + (dir / "bad.toml").string());
+  EXPECT_EQ(b.code, 2) << b.output;
+  EXPECT_NE(b.output.find("bad.toml:"), std::string::npos) << b.output;
+  EXPECT_NE(b.output.find("grains"), std::string::npos) << b.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+}
