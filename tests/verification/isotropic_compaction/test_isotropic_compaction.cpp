@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "mpmcd/analysis/time_series.hpp"
@@ -69,5 +71,36 @@ TEST(IsotropicCompaction, PhiRisesWithPressureAndTheWallsHoldTheirTargets) {
     }
     std::printf("\n");
   }
+  fs::remove_all(dir);
+}
+
+// A loading error on the command line: exit 2, the file, line, key and expectation, no output.
+TEST(IsotropicCompaction, ALoadingErrorExits2AndWritesNothing) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("mpmcd_isotropic_bad_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string example =
+      std::string(MPMCD_SOURCE_DIR) + "/examples/isotropic_compaction/isotropic_compaction_ci.toml";
+  std::ifstream in(example);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "{ name = \"left\", stress = -7.5e4 }";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "{ name = \"lefft\", stress = -7.5e4 }");
+  const std::string file = "file = \"packing_ci.csv\"";
+  text.replace(text.find(file), file.size(),
+               "file = \"" + std::string(MPMCD_SOURCE_DIR) +
+                   "/examples/isotropic_compaction/packing_ci.csv\"");
+  std::ofstream(dir / "case.toml") << text;
+  const auto r = mpmcd::test_support::run("run " + (dir / "case.toml").string() + " -o " +
+                                          (dir / "out").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("case.toml:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("key 'loading.stages[0].walls[2].name': unknown wall \"lefft\", "
+                          "expected the name of a [[walls]] entry: bottom, top, left, right "
+                          "(did you mean \"left\"?)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
   fs::remove_all(dir);
 }
