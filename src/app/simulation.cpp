@@ -300,7 +300,8 @@ RunSummary Run::go() {
   wall0_ = last_progress_ = last_checkpoint_wall_ = std::chrono::steady_clock::now();
   if (!opt_.quiet) progress_.add(progress_sample(last_, 0.0).first);
   const double t_end = cfg_.time.end_time, eps = 1e-9 * cfg_.time.dt;
-  while (t_ < t_end - eps) {
+  // A restart from the checkpoint of a loading that has ended has nothing left to do.
+  while (t_ < t_end - eps && !loading_.finished()) {
     double remaining = t_end - t_;
     // A stage of given duration ends on a step boundary.
     if (const auto te = loading_.stage_end_time(); te && *te - t_ > eps)
