@@ -42,7 +42,7 @@ std::optional<BoxWalls> find_box(std::span<const Plane> walls) {
 
 Box box_at(std::span<const Plane> walls, const BoxWalls& b, double t) {
   auto at = [&](std::size_t k, int axis) {
-    return walls[k].point[axis] + t * walls[k].velocity[axis];
+    return walls[k].point[axis] + (t - walls[k].t0) * walls[k].velocity[axis];
   };
   Box box;
   box.x_min = at(b.left, 0);

@@ -72,6 +72,11 @@ CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Mode
         "walls with normals +x, -x, +y, -y)");
 }
 
+void CompactionObserver::move_walls(const std::vector<mpm::Wall<2>>& walls) {
+  for (std::size_t k = 0; k < walls_.size() && k < walls.size(); ++k)
+    walls_[k] = {walls[k].point, walls[k].normal, walls[k].velocity, walls[k].t0};
+}
+
 std::string CompactionObserver::csv_header() const {
   std::string h;
   if (box_) {

@@ -19,6 +19,7 @@
 #include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/simulation.hpp"
 #include "mpmcd/app/step_controller.hpp"
+#include "mpmcd/app/wall_loading.hpp"
 #include "mpmcd/parallel/comm.hpp"
 #include "mpmcd/parallel/partition.hpp"
 
@@ -55,6 +56,8 @@ class Run {
   void commit(const mpm::StepStats& st, double dt);
   void rebalance();
   std::optional<std::string> stop_criterion(const mpm::StepStats& st);
+  double grain_area();
+  std::optional<std::string> loading_step(const mpm::StepStats& st, double dt);
   bool between_steps(const mpm::StepStats& st, bool at_end);
   RunSummary finish();
   // run_records.cpp: what the run writes.
@@ -72,7 +75,7 @@ class Run {
   const checkpoint::State* restart_;  // the checkpoint continued (nullptr: a new run)
   mpm::Model<2> model_;
   const mpm::Settings<2> settings_;
-  const CompactionObserver observer_;
+  CompactionObserver observer_;  // follows the walls moved by loading_
   const parallel::Comm& comm_;
   const bool root_;
   const parallel::Scheme scheme_;
@@ -81,6 +84,7 @@ class Run {
   std::optional<SignalGuard> signals_;
   std::unique_ptr<mpm::ImplicitSolver<2>> solver_;
   EnergyLedger<2> ledger_;
+  WallLoading loading_;           // [loading]: the walls' motion in stages (inactive without it)
   std::unique_ptr<Outputs> out_;  // rank 0 only
   StepController dt_control_;
   ProgressEstimator progress_;

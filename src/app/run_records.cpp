@@ -47,7 +47,8 @@ void Run::record(bool force) {
     if (root_) {
       const auto d = mpm::diagnostics(model_);
       out_->csv_row(summary_.steps, t_, dt_control_.dt(), last_, d,
-                    observer_.csv_fields(model_, last_, problem, t_) + ledger_.csv_fields(d));
+                    observer_.csv_fields(model_, last_, problem, t_) + loading_.csv_fields(t_) +
+                        ledger_.csv_fields(d));
     }
     next_csv_ = t_ + cfg_.output.csv_interval;
   }
@@ -96,7 +97,9 @@ std::string Run::write_checkpoint(const std::string& reason) {
   if (!root_) return std::string();
   checkpoint::State s = state_now(reason);
   s.grain_work = std::move(work);
-  store_run(cfg_, model_, warm, settings_.contact.walls, s);
+  store_run(cfg_, model_, warm, loading_.active() ? loading_.walls(t_) : settings_.contact.walls,
+            s);
+  if (loading_.active()) store_loading(loading_.state(), s);
   const std::string path =
       (fs::path(out_->dir()) / checkpoint::file_name(cfg_.simulation.name, s.step)).string();
   checkpoint::write(s, path);

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <stdexcept>
+
 #include "mpmcd/app/model_builder.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/io/load_config.hpp"
@@ -133,7 +135,7 @@ void store_run(const io::Config& cfg, const mpm::Model<Dim>& model,
   }
   s.wall_point.clear();
   for (const auto& w : walls) {
-    const Vec<Dim> x = w.point + s.time * w.velocity;
+    const Vec<Dim> x = w.point_at(s.time);
     for (int a = 0; a < Dim; ++a) s.wall_point.push_back(x[a]);
   }
 }
@@ -144,6 +146,60 @@ std::vector<mpm::WarmImpulse<Dim>> warm_start_of(const checkpoint::State& s) {
   for (std::size_t k = 0; k < warm.size(); ++k)
     warm[k] = {s.warm_node[k], s.warm_a[k], s.warm_b[k], vec_at<Dim>(s.warm_impulse, k)};
   return warm;
+}
+
+namespace {
+constexpr std::size_t kLoadingStageValues = 5;  // checkpoint::State::loading_stage
+constexpr std::size_t kLoadingWallValues = 12;  // checkpoint::State::loading_wall, per wall
+}  // namespace
+
+void store_loading(const LoadingState& l, checkpoint::State& s) {
+  s.loading_stage = {static_cast<double>(l.stage), l.stage_start, l.phi0, l.eps0, l.stress0};
+  s.loading_control.clear();
+  s.loading_wall.clear();
+  for (std::size_t k = 0; k < l.programs.size(); ++k) {
+    const WallProgram& p = l.programs[k];
+    s.loading_control.push_back(static_cast<std::int32_t>(p.control));
+    for (const double x :
+         {p.v_from[0], p.v_from[1], p.v_to[0], p.v_to[1], p.s_from, p.s_to, p.t_start, p.ramp,
+          l.velocity[k][0], l.velocity[k][1], l.force[k][0], l.force[k][1]})
+      s.loading_wall.push_back(x);
+  }
+}
+
+LoadingState loading_state_of(const checkpoint::State& s) {
+  const std::size_t nw = s.loading_control.size();
+  if (s.loading_stage.size() != kLoadingStageValues)
+    throw std::invalid_argument(
+        "the input has [loading], the checkpoint no loading state (written without it)");
+  if (s.loading_wall.size() != nw * kLoadingWallValues || s.wall_point.size() != 2 * nw)
+    throw std::invalid_argument(fmt::format(
+        "the checkpoint's loading state has {} values for {} walls, expected {} per wall",
+        s.loading_wall.size(), nw, kLoadingWallValues));
+  LoadingState l;
+  l.stage = static_cast<std::int32_t>(s.loading_stage[0]);
+  l.stage_start = s.loading_stage[1];
+  l.phi0 = s.loading_stage[2];
+  l.eps0 = s.loading_stage[3];
+  l.stress0 = s.loading_stage[4];
+  for (std::size_t k = 0; k < nw; ++k) {
+    const double* x = &s.loading_wall[k * kLoadingWallValues];
+    if (s.loading_control[k] != 0 && s.loading_control[k] != 1)
+      throw std::invalid_argument(fmt::format("wall {} has control {}", k, s.loading_control[k]));
+    WallProgram p;
+    p.control = static_cast<WallControl>(s.loading_control[k]);
+    p.v_from = Vec<2>(x[0], x[1]);
+    p.v_to = Vec<2>(x[2], x[3]);
+    p.s_from = x[4];
+    p.s_to = x[5];
+    p.t_start = x[6];
+    p.ramp = x[7];
+    l.programs.push_back(p);
+    l.velocity.emplace_back(x[8], x[9]);
+    l.force.emplace_back(x[10], x[11]);
+    l.position.emplace_back(s.wall_point[2 * k], s.wall_point[2 * k + 1]);
+  }
+  return l;
 }
 
 void store_energy(const EnergySums& e, checkpoint::State& s) {

@@ -103,6 +103,7 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
                               [](const auto& b) { return b.moving; })),
       stop_active_(cfg.stop.phi > 0 || cfg.stop.strain > 0 || cfg.stop.stress > 0),
       ledger_(start_energy(cfg, model_, restart)),
+      loading_(cfg, settings_.contact.walls, model_),
       dt_control_(cfg.time),
       progress_(cfg.time.end_time, cfg.stop, observer_.initial_phi()),
       t_(restart ? restart->time : 0.0),
@@ -121,15 +122,30 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
   solver_->set_boundary_conditions(build_boundaries(cfg, model_.grid, 0.0));
   distribute();
   if (root_)  // after every input check: nothing written before
-    out_ = std::make_unique<Outputs>(cfg, summary_.output_dir,
-                                     observer_.csv_header() + EnergyLedger<2>::csv_header(cfg),
-                                     restart, history_dir);
+    out_ = std::make_unique<Outputs>(
+        cfg, summary_.output_dir,
+        observer_.csv_header() + loading_.csv_header() + EnergyLedger<2>::csv_header(cfg), restart,
+        history_dir);
   log().info(
       "mpmcd {} ({}): {} grains, {} material points, grid {}x{} cells of {} m, {} rank(s) x {} "
       "threads ({})",
       kVersion, kGitHash, model_.grains.size(), model_.points.size(), model_.grid.cells()[0],
       model_.grid.cells()[1], model_.grid.cell_size(), comm_.size(), omp_get_max_threads(),
       openmp_wait_policy());
+  if (loading_.active()) {
+    if (restart) {
+      try {
+        loading_.restore(loading_state_of(*restart));
+      } catch (const std::invalid_argument& e) {
+        throw InputError(opt.restart, 0, "",
+                         fmt::format("checkpoint does not fit its input: {}", e.what()));
+      }
+      observer_.move_walls(loading_.walls(t_));
+    } else {
+      loading_.start(CompactionObserver::total_area(CompactionObserver::grain_areas(model_)));
+    }
+    log().info("{}", loading_.describe());
+  }
   if (restart) {
     dt_control_.restore(restart->dt, restart->good_since_cut);
     summary_.steps = restart->step;
@@ -179,7 +195,7 @@ void Run::distribute() {
 void Run::commit(const mpm::StepStats& st, double dt) {
   solver_->commit();
   last_ = st;
-  ledger_.add_step(st, settings_.contact.walls, dt);
+  ledger_.add_step(st, solver_->settings().contact.walls, dt);  // the walls of this step
   if (comm_.size() > 1 && scheme_ == parallel::Scheme::kPartition && opt_.rebalance > 0 &&
       (summary_.steps + 1) % 50 == 0)  // docs/parallel.md: deterministic work weights
     rebalance();
@@ -214,6 +230,32 @@ std::optional<std::string> Run::stop_criterion(const mpm::StepStats& st) {
   auto areas = CompactionObserver::grain_areas(model_, &solver_->owner(), comm_.rank());
   comm_.sum(areas);
   return observer_.stop_reason(CompactionObserver::total_area(areas), st, t_);
+}
+
+// V_s, the grains' current area [m^2] (collective on several ranks: summed per grain over the
+// ranks, then over the grains in order, as stop_criterion does).
+double Run::grain_area() {
+  if (comm_.size() == 1)
+    return CompactionObserver::total_area(CompactionObserver::grain_areas(model_));
+  auto areas = CompactionObserver::grain_areas(model_, &solver_->owner(), comm_.rank());
+  comm_.sum(areas);
+  return CompactionObserver::total_area(areas);
+}
+
+// The loading after the committed step of length dt [s] (every rank: the wall forces are
+// reduced over the ranks, Phi when a stage needs it is collective): walls moved, stage ended.
+// Returns the reason to end the run once the last stage has ended.
+std::optional<std::string> Run::loading_step(const mpm::StepStats& st, double dt) {
+  if (!loading_.active()) return std::nullopt;
+  loading_.committed(st, dt);
+  observer_.move_walls(loading_.walls(t_));
+  const double area = loading_.needs_area() ? grain_area() : 0.0;
+  if (const auto ended = loading_.advance(t_, area)) {
+    if (loading_.finished()) return "loading finished: " + *ended;  // logged as the run's end
+    log().info("step {}: {}; stage {} ('{}') starts", summary_.steps, *ended,
+               loading_.state().stage + 1, loading_.stage_name());
+  }
+  return std::nullopt;
 }
 
 // After a committed step that did not end the run (`at_end`: it reached end_time): a signal or
@@ -260,9 +302,15 @@ RunSummary Run::go() {
   wall0_ = last_progress_ = last_checkpoint_wall_ = std::chrono::steady_clock::now();
   if (!opt_.quiet) progress_.add(progress_sample(last_, 0.0).first);
   const double t_end = cfg_.time.end_time, eps = 1e-9 * cfg_.time.dt;
-  while (t_ < t_end - eps) {
-    const double dt = dt_control_.next(t_end - t_);
+  // A restart from the checkpoint of a loading that has ended has nothing left to do.
+  while (t_ < t_end - eps && !loading_.finished()) {
+    double remaining = t_end - t_;
+    // A stage of given duration ends on a step boundary.
+    if (const auto te = loading_.stage_end_time(); te && *te - t_ > eps)
+      remaining = std::min(remaining, *te - t_);
+    const double dt = dt_control_.next(remaining);
     solver_->set_time(t_);
+    if (loading_.active()) solver_->set_walls(loading_.step_walls(t_, dt));
     if (any_moving_) solver_->set_boundary_conditions(build_boundaries(cfg_, model_.grid, t_ + dt));
     const mpm::StepStats st = solver_->solve_step(dt);
     if (!st.converged) {  // the same verdict on every rank (the solver reduces it)
@@ -273,7 +321,8 @@ RunSummary Run::go() {
       continue;
     }
     commit(st, dt);
-    const std::optional<std::string> criterion = stop_criterion(st);
+    std::optional<std::string> criterion = loading_step(st, dt);
+    if (!criterion) criterion = stop_criterion(st);
     const bool at_end = criterion.has_value() || t_ >= t_end - eps;
     record(at_end);
     if (criterion) {

@@ -283,6 +283,12 @@ std::uint64_t payload_checksum(const State& s) {
     h = hash_array(*a, h);
   for (const auto* a : {&s.grain, &s.grain_material, &s.warm_a, &s.warm_b, &s.grain_owner})
     h = hash_array(*a, h);
+  // Version 7: the wall loading, hashed only when present (a state without it, such as every
+  // version 6 file, keeps the checksum of version 6).
+  if (!s.loading_stage.empty() || !s.loading_control.empty() || !s.loading_wall.empty()) {
+    for (const auto* a : {&s.loading_stage, &s.loading_wall}) h = hash_array(*a, h);
+    h = hash_array(s.loading_control, h);
+  }
   h = hash_value(s.ranks, h);
   h = fnv1a(s.scheme, h);
   h = hash_value(s.threads, h);
@@ -348,6 +354,10 @@ void write(const State& s, const std::string& path) {
     w.group("/walls");
     w.array("/walls/point", s.wall_point, {s.wall_point.size() / std::max<hsize_t>(d, 1), d});
     w.array("/walls/work", s.wall_work, {s.wall_work.size()});
+    w.group("/loading");
+    w.array("/loading/stage", s.loading_stage, {s.loading_stage.size()});
+    w.array("/loading/control", s.loading_control, {s.loading_control.size()});
+    w.array("/loading/wall", s.loading_wall, {s.loading_wall.size()});
     w.scalar("/time/energy0", s.energy0);
     w.scalar("/time/contact_dissipation", s.contact_dissipation);
     w.scalar("/time/kinetic0", s.kinetic0);
@@ -399,6 +409,7 @@ State read(const std::string& path) {
   // the file: the header block (text and NUL padding) with its 16 digits read as '0', then the
   // HDF5 part.
   std::size_t file_bytes = 0;
+  int file_version = 0;
   {
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) throw refuse("cannot open the file");
@@ -417,9 +428,10 @@ State read(const std::string& path) {
     if (std::sscanf(head.c_str(), "MPMCD-CHECKPOINT %d\nbytes %llu\nfnv1a64 %llx", &version,
                     &want_bytes, &want_sum) != 3)
       throw fail("unreadable header");
-    if (version != kFormatVersion)
-      throw fail(
-          fmt::format("format version {}, this mpmcd reads version {}", version, kFormatVersion));
+    if (version < kOldestFormatVersion || version > kFormatVersion)
+      throw fail(fmt::format("format version {}, this mpmcd reads versions {} to {}", version,
+                             kOldestFormatVersion, kFormatVersion));
+    file_version = version;
     const std::size_t digits = head.find(kSumKey);
     if (digits == std::string::npos || digits + kSumKey.size() + kSumDigits > head.size() ||
         !std::all_of(head.begin() + static_cast<long>(digits + kSumKey.size()),
@@ -448,8 +460,8 @@ State read(const std::string& path) {
   State s;
   constexpr hsize_t any = Reader::kAny;
   if (r.text("/meta/format") != kMagic) r.fail("/meta/format", "not an mpmcd checkpoint");
-  if (r.scalar<std::int32_t>("/meta/format_version") != kFormatVersion)
-    r.fail("/meta/format_version", "unsupported format version");
+  if (r.scalar<std::int32_t>("/meta/format_version") != file_version)
+    r.fail("/meta/format_version", "not the version of the file's header");
   s.mpmcd_version = r.text("/meta/mpmcd_version");
   s.input_text = r.text("/meta/input_text");
   s.input_path = r.text("/meta/input_path");
@@ -494,6 +506,11 @@ State read(const std::string& path) {
   s.warm_impulse = r.array<double>("/contact/warm_impulse", {nw, d});
   s.wall_point = r.array<double>("/walls/point", {any, d});
   s.wall_work = r.array<double>("/walls/work", {s.wall_point.size() / d});
+  if (file_version >= 7) {
+    s.loading_stage = r.array<double>("/loading/stage", {any});
+    s.loading_control = r.array<std::int32_t>("/loading/control", {any});
+    s.loading_wall = r.array<double>("/loading/wall", {any});
+  }
   s.energy0 = r.scalar<double>("/time/energy0");
   s.contact_dissipation = r.scalar<double>("/time/contact_dissipation");
   s.kinetic0 = r.scalar<double>("/time/kinetic0");

@@ -68,6 +68,9 @@ Schema build_schema() {
             .defaults("its defaults"),
         KeySpec::subtable("contact", &Config::contact, "Contact Dynamics").defaults("its defaults"),
         KeySpec::table_array("walls", &Config::walls, "rigid walls").defaults("none"),
+        KeySpec::subtable("loading", &Config::loading,
+                          "wall loading stages (velocity or stress control)")
+            .defaults("none"),
         KeySpec::subtable("stop", &Config::stop, "compaction stop criteria").defaults("none"),
         KeySpec::subtable("output", &Config::output, "output files").defaults("its defaults"),
         KeySpec::subtable("checkpoint", &Config::checkpoint, "restart files")
@@ -387,6 +390,93 @@ Schema build_schema() {
                        "Coulomb coefficient with the grains")
            .at_least(0.0)
            .default_of_member()});
+
+  s.add_table(
+      &Config::loading,
+      "Wall motions in stages (docs/loading.md), instead of the walls' constant velocities: each "
+      "stage sets, for the walls it lists, a target velocity or a target normal stress, reached "
+      "linearly over `ramp` and then held, until one of its end conditions. A stress-controlled "
+      "wall moves along its normal at v_n = clamp(gain (sigma_measured - sigma_target), "
+      "-max_speed, max_speed) (a servo; sigma_measured from the wall force of the last step over "
+      "the wall's length between its neighbours, as the `wall_<name>_stress` column), so it "
+      "needs the four walls of a box. With `[loading]`, `walls[].velocity` must be absent or "
+      "zero; the walls start at rest.",
+      {KeySpec::number("gain", &LoadingSection::gain, "m/(s Pa)",
+                       "servo gain g (speed per stress error)")
+           .greater_than(0.0)
+           .defaults("gain_fraction min(dt/(rho h), h/(M_p dt))"),
+       KeySpec::number("gain_fraction", &LoadingSection::gain_fraction, "",
+                       "the automatic gain as a fraction of the step's stability limit "
+                       "min(dt/(rho h), h/(M_p dt)) (rho, M_p: the densest and stiffest grain "
+                       "material, dt = time.dt, h = grid.cell_size)")
+           .greater_than(0.0)
+           .at_most(1.0)
+           .default_of_member(),
+       KeySpec::number("max_speed", &LoadingSection::max_speed, "m/s",
+                       "speed limit of a stress-controlled wall")
+           .greater_than(0.0)
+           .defaults("0.02 c_p (the grains' slowest P-wave speed)"),
+       KeySpec::table_array("stages", &LoadingSection::stages, "the loading stages, in order")
+           .require()
+           .nonempty()});
+
+  s.add_table(
+      &LoadingSection::stages,
+      "One loading stage. The walls it does not list keep their control and target (a ramp in "
+      "progress goes on). Every stage but the last needs an end condition (`until`); the run "
+      "ends when the last stage ends (or at `time.end_time`).",
+      {KeySpec::string("name", &StageSection::name, "name shown in the log")
+           .nonempty()
+           .defaults("stage <k>"),
+       KeySpec::number("ramp", &StageSection::ramp, "s",
+                       "time over which the listed walls' targets go linearly from their values "
+                       "at the stage start (a stress target from the previous target, or from the "
+                       "measured stress for a wall that was velocity-controlled) to the stage's; "
+                       "0 = at once (a step)")
+           .at_least(0.0)
+           .default_of_member(),
+       KeySpec::subtable("until", &StageSection::until, "end conditions").defaults("none"),
+       KeySpec::table_array("walls", &StageSection::walls, "the walls whose control changes")
+           .defaults("none")});
+
+  s.add_table(
+      &StageSection::until,
+      "End conditions of a stage, checked after every step; the first reached ends it. Phi, "
+      "eps and a wall stress end it when they cross the value from the side they were on at the "
+      "stage start (so a stage may load or unload). Phi, eps and stresses are those of the CSV "
+      "(docs/observables.md) and need the four walls of a box.",
+      {KeySpec::number("time", &StageUntilSection::time, "s", "duration of the stage")
+           .greater_than(0.0)
+           .defaults("none"),
+       KeySpec::number("phi", &StageUntilSection::phi, "", "solid fraction Phi = Vs/V to cross")
+           .greater_than(0.0)
+           .at_most(1.0)
+           .defaults("none"),
+       KeySpec::number("strain", &StageUntilSection::strain, "",
+                       "eps = ln(h/h0) to cross (compression negative)")
+           .defaults("none"),
+       KeySpec::number("stress", &StageUntilSection::stress, "Pa",
+                       "normal stress of wall `wall` to cross (compression negative)")
+           .less_than(0.0)
+           .defaults("none"),
+       KeySpec::string("wall", &StageUntilSection::wall, "the wall whose stress `stress` watches")
+           .nonempty()
+           .with_note("with stress")});
+
+  s.add_table(
+      &StageSection::walls,
+      "What one wall does from this stage on: `velocity` (its whole velocity), or `stress` (its "
+      "normal motion by the servo; `velocity` may then add a slide along the wall, its normal "
+      "component zero).",
+      {KeySpec::string("name", &StageWallSection::name, "name of a `[[walls]]` entry")
+           .require()
+           .nonempty(),
+       KeySpec::numbers("velocity", &StageWallSection::velocity, "Dim", "m/s", "target velocity")
+           .defaults("none"),
+       KeySpec::number("stress", &StageWallSection::stress, "Pa",
+                       "target normal stress (compression negative, as `wall_<name>_stress`)")
+           .less_than(0.0)
+           .defaults("none")});
 
   s.add_table(
       &Config::stop,

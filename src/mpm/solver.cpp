@@ -42,6 +42,13 @@ template <int Dim>
 ImplicitSolver<Dim>::~ImplicitSolver() = default;
 
 template <int Dim>
+void ImplicitSolver<Dim>::set_walls(std::vector<Wall<Dim>> walls) {
+  if (walls.size() != settings_.contact.walls.size())
+    throw std::logic_error("ImplicitSolver::set_walls: another number of walls");
+  settings_.contact.walls = std::move(walls);
+}
+
+template <int Dim>
 void ImplicitSolver<Dim>::set_boundary_conditions(const std::vector<VelocityBC<Dim>>& bcs) {
   prescribed_.set(bcs);  // clears only the nodes set before (moving node sets change every step)
 }

@@ -16,11 +16,13 @@
 
 namespace mpmcd::analysis {
 
-/// A rigid plane wall: the plane through point + velocity t with unit normal into the domain.
+/// A rigid plane wall: the plane through point + velocity (t - t0) with unit normal into the
+/// domain.
 struct Plane {
-  Vec<2> point = Vec<2>::Zero();     ///< a point of the plane at t = 0 [m]
+  Vec<2> point = Vec<2>::Zero();     ///< a point of the plane at time t0 [m]
   Vec<2> normal = Vec<2>::Zero();    ///< unit normal into the domain [-]
   Vec<2> velocity = Vec<2>::Zero();  ///< prescribed velocity [m/s]
+  double t0 = 0.0;                   ///< time at which the plane passes through `point` [s]
 };
 
 /// Which of the walls bound an axis-aligned rectangular box (indices into the wall list).
@@ -47,7 +49,7 @@ struct Box {
 /// (each component within 1e-12 of 0 or ±1); nullopt otherwise.
 std::optional<BoxWalls> find_box(std::span<const Plane> walls);
 
-/// The box bounded by the walls at time t [s]: each wall at point + velocity t.
+/// The box bounded by the walls at time t [s]: each wall at point + velocity (t - t0).
 Box box_at(std::span<const Plane> walls, const BoxWalls& box, double t);
 
 /// Length of wall `k` [m] inside the box: the width for the bottom and top walls, the height for

@@ -63,6 +63,10 @@ class CompactionObserver {
   /// run uses, so that per-grain sums gathered from several ranks give the same bits.
   static double total_area(const std::vector<double>& areas);
 
+  /// Follows walls whose motion is not their input's constant velocity (app::WallLoading): the
+  /// box is then that of `walls` (same order as the input's [[walls]]).
+  void move_walls(const std::vector<mpm::Wall<2>>& walls);
+
   /// Replaces V_s0, the grains' area at t = 0 [m^2] (a restarted run must pass the value of the
   /// original start, e.g. from the first CSV row, since the constructor measures the model it is
   /// given; the box at t = 0 follows from the walls and needs nothing).

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mpmcd/app/energy_ledger.hpp"
+#include "mpmcd/app/wall_loading.hpp"
 #include "mpmcd/checkpoint/checkpoint.hpp"
 #include "mpmcd/io/config.hpp"
 #include "mpmcd/mpm/model.hpp"
@@ -35,6 +36,12 @@ mpm::Model<Dim> restore_model(const io::Config& config, const checkpoint::State&
 /// The contact warm start held by `state` (impulses of the last converged step).
 template <int Dim>
 std::vector<mpm::WarmImpulse<Dim>> warm_start_of(const checkpoint::State& state);
+
+/// Stores the wall loading's state in `state` (docs/loading.md).
+void store_loading(const LoadingState& loading, checkpoint::State& state);
+/// The wall loading's state held by `state` (walls at state.wall_point). Throws
+/// std::invalid_argument when the checkpoint has none or a malformed one.
+LoadingState loading_state_of(const checkpoint::State& state);
 
 /// Stores the energy ledger's sums in `state`.
 void store_energy(const EnergySums& sums, checkpoint::State& state);

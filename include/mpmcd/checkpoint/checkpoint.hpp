@@ -13,7 +13,10 @@
 namespace mpmcd::checkpoint {
 
 /// Layout version of the files this build writes and reads [-].
-inline constexpr std::int32_t kFormatVersion = 6;
+inline constexpr std::int32_t kFormatVersion = 7;
+
+/// Oldest layout version this build still reads (version 6: no wall loading) [-].
+inline constexpr std::int32_t kOldestFormatVersion = 6;
 
 /// Size of the text header (HDF5 user block) before the HDF5 data [bytes].
 inline constexpr std::size_t kHeaderBytes = 512;
@@ -79,6 +82,16 @@ struct State {
   double transfer_dissipation = 0;  ///< kinetic energy lost by P2G and G2P since t = 0 [J]
   double stress_work = 0;  ///< work of the internal forces on the grid since t = 0 [J] (2D: J/m)
   double body_work = 0;    ///< work of the body forces on the grid since t = 0 [J] (2D: J/m)
+  // Wall loading ([loading], docs/loading.md; empty without it, and in version 6 files).
+  /// Current stage index, its start time [s], and Phi [-], eps [-] and the until-wall stress
+  /// [Pa] at its start (5 values) [-].
+  std::vector<double> loading_stage;
+  /// Per wall, app::WallProgram's control: 0 velocity, 1 stress [-].
+  std::vector<std::int32_t> loading_control;
+  /// Per wall, 12 values: the program's v_from (dim) [m/s], v_to (dim) [m/s], s_from, s_to [Pa],
+  /// t_start, ramp [s]; the velocity of the last step (dim) [m/s]; the force of the grains on
+  /// it in the last step (dim) [N] (2D: N/m); its position is wall_point.
+  std::vector<double> loading_wall;
   // Distribution (docs/parallel.md): restored when the rank count and scheme are the same.
   std::int32_t ranks = 1;                 ///< MPI ranks of the writing run [-]
   std::string scheme = "partition";       ///< parallel scheme of the writing run [-]

@@ -138,6 +138,51 @@ struct WallSection {
   std::int64_t line = 0;         ///< line of the table in the input
 };
 
+/// [[loading.stages.walls]]: what one wall does during a stage (docs/loading.md). `velocity`
+/// prescribes the wall's whole velocity; `stress` drives its normal motion by the servo toward a
+/// target normal stress (then `velocity` may only give a tangential slide).
+struct StageWallSection {
+  std::string name;              ///< name of a [[walls]] entry [-]
+  std::vector<double> velocity;  ///< target velocity [m/s], Dim entries (empty: not given)
+  double stress = 0.0;           ///< target normal stress, compression negative [Pa]
+  bool has_stress = false;       ///< `stress` was given [-]
+  std::int64_t line = 0;         ///< line of the table in the input
+};
+
+/// [loading.stages.until]: when a stage ends (the first condition reached; none: at end_time).
+/// Φ, ε and the wall stress end the stage when they cross the value from their stage-start side.
+struct StageUntilSection {
+  double time = 0.0;        ///< stage duration [s] (0: not set)
+  double phi = 0.0;         ///< solid fraction Φ to cross [-] (0: not set)
+  double strain = 0.0;      ///< ε = ln(h/h0) to cross (compression negative) [-]
+  bool has_strain = false;  ///< `strain` was given [-]
+  double stress = 0.0;      ///< normal stress of wall `wall` to cross, compression negative [Pa]
+  bool has_stress = false;  ///< `stress` was given [-]
+  std::string wall;         ///< the wall whose stress `stress` watches [-]
+  std::int64_t line = 0;    ///< line of the table in the input
+};
+
+/// [[loading.stages]]: one loading stage.
+struct StageSection {
+  std::string name;                     ///< name shown in the log [-] (default "stage <k>")
+  double ramp = 0.0;                    ///< time over which the targets go linearly to theirs [s]
+  StageUntilSection until;              ///< end conditions
+  bool has_until = false;               ///< an [until] table was given [-]
+  std::vector<StageWallSection> walls;  ///< the walls whose control changes
+  std::int64_t line = 0;                ///< line of the table in the input
+};
+
+/// [loading]: wall motions by stages, velocity- or stress-controlled (replaces the walls'
+/// constant velocities when present; docs/loading.md).
+struct LoadingSection {
+  double gain = 0.0;  ///< servo gain g, v_n = g (σ_measured - σ_target) [m/(s Pa)] (0: auto)
+  double gain_fraction = 0.25;       ///< auto gain: this fraction of min(dt/(ρ h), h/(M_p dt)) [-]
+  double max_speed = 0.0;            ///< speed limit of a servo wall [m/s] (0: auto)
+  std::vector<StageSection> stages;  ///< the stages, in order
+  bool present = false;              ///< the [loading] table was given [-]
+  std::int64_t line = 0;             ///< line of the table in the input
+};
+
 /// [stop]: optional stop criteria of a compaction (need four walls forming a box); the run stops
 /// at the first one reached or at [time] end_time (docs/observables.md). 0 = not set.
 struct StopSection {
@@ -182,6 +227,7 @@ struct Config {
   SolverSection solver;                     ///< [solver]: Newton and linear solver
   ContactSection contact;                   ///< [contact]: Contact Dynamics
   std::vector<WallSection> walls;           ///< [[walls]], in input order
+  LoadingSection loading;                   ///< [loading]: wall loading stages
   StopSection stop;                         ///< [stop]: compaction stop criteria
   OutputSection output;                     ///< [output]: output files
   CheckpointSection checkpoint;             ///< [checkpoint]: restart files

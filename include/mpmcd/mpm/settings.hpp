@@ -21,19 +21,23 @@ enum class LinearSolverKind {
 /// Parses "ldlt" / "lu" / "cg"; throws InputError otherwise.
 LinearSolverKind linear_solver_from_string(const std::string& name);
 
-/// A rigid wall: the plane through `point` + velocity t with unit `normal` pointing into the
-/// domain; it takes part in contact as a body of infinite mass.
+/// A rigid wall: the plane through `point` + velocity (t - t0) with unit `normal` pointing into
+/// the domain; it takes part in contact as a body of infinite mass. A wall whose velocity changes
+/// (app::WallLoading: stages, servo) is re-anchored at each step: point = its position at t0 = t^n.
 template <int Dim>
 struct Wall {
   std::string name;                      ///< name used in outputs
-  Vec<Dim> point = Vec<Dim>::Zero();     ///< a point of the plane at t = 0 [m]
+  Vec<Dim> point = Vec<Dim>::Zero();     ///< a point of the plane at time t0 [m]
   Vec<Dim> normal = Vec<Dim>::Zero();    ///< unit normal into the domain [-]
   Vec<Dim> velocity = Vec<Dim>::Zero();  ///< prescribed velocity [m/s]
   double friction = 0.0;                 ///< Coulomb coefficient with every grain [-]
+  double t0 = 0.0;                       ///< time at which the plane passes through `point` [s]
   /// Signed distance of x [m] from the wall at time t [s] (positive inside the domain) [m].
   double distance(const Vec<Dim>& x, double t) const {
-    return (x - point - t * velocity).dot(normal);
+    return (x - point - (t - t0) * velocity).dot(normal);
   }
+  /// A point of the plane at time t [s] [m].
+  Vec<Dim> point_at(double t) const { return point + (t - t0) * velocity; }
 };
 
 /// When a grain-grain contact switches on (method.md §4).

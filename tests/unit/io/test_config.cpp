@@ -300,3 +300,76 @@ TEST(LoadConfig, GrainsMayTouchTheOneCellMargin) {
             std::string::npos)
       << message_of(text);
 }
+
+// [loading] (docs/loading.md): every key reaches its member; inline and [[...]] tables alike;
+// stage names default to "stage <k>"; the walls without a constant velocity get zeros.
+TEST(LoadConfig, LoadingStagesFillTheirSections) {
+  const std::string walls = R"(
+[[walls]]
+name = "bottom"
+point = [0, 0.1]
+normal = [0, 1]
+[[walls]]
+name = "top"
+point = [0, 1.2]
+normal = [0, -1]
+[[walls]]
+name = "left"
+point = [-0.75, 0]
+normal = [1, 0]
+[[walls]]
+name = "right"
+point = [0.75, 0]
+normal = [-1, 0]
+[loading]
+gain = 2e-6
+max_speed = 0.5
+[[loading.stages]]
+name = "iso"
+ramp = 1e-3
+until = { time = 2e-3, phi = 0.9 }
+walls = [{ name = "left", stress = -1e5 }, { name = "right", stress = -1e5 }]
+[[loading.stages]]
+[loading.stages.until]
+strain = -0.1
+stress = -2e5
+wall = "top"
+[[loading.stages.walls]]
+name = "top"
+velocity = [0, -0.1]
+[[loading.stages.walls]]
+name = "left"
+stress = -1e5
+velocity = [0, 0.2]
+)";
+  const Config c = parse_config(kMinimal + walls, "case.toml");
+  const auto& l = c.loading;
+  EXPECT_TRUE(l.present);
+  EXPECT_EQ(l.gain, 2e-6);
+  EXPECT_EQ(l.gain_fraction, 0.25);
+  EXPECT_EQ(l.max_speed, 0.5);
+  ASSERT_EQ(l.stages.size(), 2u);
+  EXPECT_EQ(l.stages[0].name, "iso");
+  EXPECT_EQ(l.stages[0].ramp, 1e-3);
+  EXPECT_TRUE(l.stages[0].has_until);
+  EXPECT_EQ(l.stages[0].until.time, 2e-3);
+  EXPECT_EQ(l.stages[0].until.phi, 0.9);
+  EXPECT_FALSE(l.stages[0].until.has_strain);
+  ASSERT_EQ(l.stages[0].walls.size(), 2u);
+  EXPECT_EQ(l.stages[0].walls[1].name, "right");
+  EXPECT_TRUE(l.stages[0].walls[1].has_stress);
+  EXPECT_EQ(l.stages[0].walls[1].stress, -1e5);
+  EXPECT_TRUE(l.stages[0].walls[1].velocity.empty());
+  EXPECT_EQ(l.stages[1].name, "stage 2");
+  EXPECT_TRUE(l.stages[1].until.has_strain);
+  EXPECT_EQ(l.stages[1].until.strain, -0.1);
+  EXPECT_TRUE(l.stages[1].until.has_stress);
+  EXPECT_EQ(l.stages[1].until.wall, "top");
+  EXPECT_FALSE(l.stages[1].walls[0].has_stress);
+  EXPECT_EQ(l.stages[1].walls[0].velocity, (std::vector<double>{0, -0.1}));
+  // Stress with a slide along the wall (normal component 0) is accepted.
+  EXPECT_TRUE(l.stages[1].walls[1].has_stress);
+  EXPECT_EQ(l.stages[1].walls[1].velocity, (std::vector<double>{0, 0.2}));
+  EXPECT_EQ(c.walls[1].velocity, (std::vector<double>{0, 0}));
+  EXPECT_FALSE(parse_config(kMinimal, "case.toml").loading.present);
+}

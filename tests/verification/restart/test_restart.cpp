@@ -330,3 +330,23 @@ TEST(Restart, AnotherThreadCountPrintsANote) {
       << read(dir / "c.log");
   EXPECT_EQ(read(dir / "c.log").find("note:"), std::string::npos) << read(dir / "c.log");
 }
+
+// Checkpoint format 7 added the wall loading; a format 6 file (written by the mpmcd before it,
+// format6/: a disk over a rising floor, stopped after step 1 of 3) is still read and continues
+// the run to the same CSV bytes as that mpmcd's uninterrupted run (format6/tiny_full.csv).
+TEST(Restart, AFormat6CheckpointStillContinuesBitwise) {
+  const fs::path src = fs::path(MPMCD_TEST_DIR) / "format6";
+  const fs::path dir = scratch("format6");
+  const fs::path ckpt = dir / "tiny_checkpoint_000000001.h5";
+  fs::copy_file(src / "tiny_checkpoint_000000001.h5", ckpt);
+  fs::copy_file(src / "tiny_step1.csv", dir / "tiny.csv");
+  ASSERT_EQ(read(ckpt).rfind("MPMCD-CHECKPOINT 6\n", 0), 0u);
+  const ck::State s = ck::read(ckpt.string());
+  EXPECT_EQ(s.step, 1);
+  EXPECT_TRUE(s.loading_stage.empty() && s.loading_control.empty() && s.loading_wall.empty());
+  const int rc = run_binary({"run", "-q", "-t", "1", "--restart", ckpt.string()}, dir / "run.log");
+  ASSERT_EQ(rc, 0) << read(dir / "run.log");
+  EXPECT_TRUE(read(dir / "tiny.csv") == read(src / "tiny_full.csv"))
+      << read(dir / "tiny.csv") << "\nexpected\n"
+      << read(src / "tiny_full.csv");
+}

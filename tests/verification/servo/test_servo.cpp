@@ -1,0 +1,253 @@
+// Stress-controlled walls and loading stages ([loading], docs/loading.md) through the app, as a
+// user runs them: a Neo-Hookean block between four frictionless walls whose top wall is a servo
+// holds the target stress within 1 % after its settling time (wall stresses, every point's
+// sigma22 and the closed form of uniaxial strain, method.md §7); stages end on their `until`
+// conditions (stress, time, strain) and ramps follow their line; a restart in the middle of a
+// stage continues bitwise.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "mpmcd/analysis/time_series.hpp"
+#include "mpmcd/app/run_state.hpp"
+#include "mpmcd/app/simulation.hpp"
+#include "mpmcd/checkpoint/checkpoint.hpp"
+#include "mpmcd/core/log.hpp"
+#include "mpmcd/io/load_config.hpp"
+
+namespace fs = std::filesystem;
+namespace ck = mpmcd::checkpoint;
+
+namespace {
+
+constexpr double kLambda = 3e6, kMu = 1.5e6;  // the block's Neo-Hookean material [Pa]
+constexpr double kH0 = 1e-3;                  // the block's initial height and width [m]
+
+fs::path scratch(const std::string& name) {
+  // The pid keeps concurrent test runs (other build trees on the machine) apart.
+  fs::path p = fs::temp_directory_path() / ("mpmcd_servo_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The block [0.5, 1.5] mm^2 between four walls touching it (uniaxial strain), cell size h [m],
+// 2 x 2 points per cell, CPDI + affine + face walls (the configuration that keeps a walled block
+// homogeneous, docs/accuracy.md), time step dt [s]; `loading` is the [loading] part.
+std::string block_input(double h, double dt, double end_time, const std::string& loading) {
+  std::ostringstream in;
+  in.precision(17);
+  in << "[simulation]\nname = \"block\"\n"
+        "[grid]\norigin = [0.0, 0.0]\nextent = [2e-3, 2e-3]\ncell_size = "
+     << h
+     << "\nshape_function = \"cpdi\"\n"
+        "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\nlambda = "
+     << kLambda << "\nmu = " << kMu
+     << "\n[[grains]]\nshape = \"rectangle\"\nmaterial = \"gel\"\n"
+        "min_corner = [0.5e-3, 0.5e-3]\nmax_corner = [1.5e-3, 1.5e-3]\npoints_per_cell = 2\n"
+        "[time]\ndt = "
+     << dt << "\nend_time = " << end_time
+     << "\n[solver]\naffine = true\nresidual_tolerance = 1e-10\nincrement_tolerance = 1e-10\n"
+        "[contact]\nwall_contact = \"points\"\ntolerance = 1e-10\nimpulse_tolerance = 1e-10\n"
+        "[[walls]]\nname = \"bottom\"\npoint = [0.0, 0.5e-3]\nnormal = [0.0, 1.0]\n"
+        "[[walls]]\nname = \"top\"\npoint = [0.0, 1.5e-3]\nnormal = [0.0, -1.0]\n"
+        "[[walls]]\nname = \"left\"\npoint = [0.5e-3, 0.0]\nnormal = [1.0, 0.0]\n"
+        "[[walls]]\nname = \"right\"\npoint = [1.5e-3, 0.0]\nnormal = [-1.0, 0.0]\n"
+     << loading << "[output]\nfolder = \"out\"\nvtu = false\n";
+  return in.str();
+}
+
+mpmcd::app::RunSummary run(const std::string& text, const fs::path& dir,
+                           std::int64_t stop_after = 0) {
+  mpmcd::setup_logging(mpmcd::Verbosity::kQuiet);
+  const fs::path in = dir / "block.toml";
+  std::ofstream(in) << text;
+  const auto cfg = mpmcd::io::load_config(in.string());
+  mpmcd::app::RunOptions opt;
+  opt.threads = 1;
+  opt.quiet = true;
+  opt.output_dir = (dir / "out").string();
+  opt.stop_after = stop_after;
+  return mpmcd::app::run_simulation(cfg, opt);
+}
+
+// sigma22 of the homogeneous uniaxial strain F = diag(1, s) (method.md §7) [Pa].
+double sigma22(double s) {
+  return (kMu * (s * s - 1) + kLambda * std::log(s)) / s;
+}
+
+// sigma11 of the same state [Pa].
+double sigma11(double s) {
+  return kLambda * std::log(s) / s;
+}
+
+}  // namespace
+
+// The top wall is a servo with the automatic gain; its target -0.3 MPa is ramped over 0.1 ms and
+// held. Settling time (docs/loading.md): tau = H / (M_p g) = 67 us for g = 0.25 min(dt/(rho h),
+// h/(M_p dt)) at c_p dt / h = 0.78, and the ramp leaves a lag of about rate x tau; the check
+// starts 3 ms later, at 0.4 ms (about 5 tau after the ramp).
+TEST(Servo, HoldsTargetStressOnElasticBlockWithinOnePercent) {
+  const fs::path dir = scratch("hold");
+  const double target = -3e5, ramp = 1e-4, settled = 4e-4, h = 1e-4, dt = 1e-6;
+  const auto summary = run(block_input(h, dt, 1e-3,
+                                       "[loading]\n[[loading.stages]]\nname = \"press\"\n"
+                                       "ramp = 1e-4\nuntil = { time = 5e-4 }\n"
+                                       "[[loading.stages.walls]]\nname = \"top\"\nstress = -3e5\n"),
+                           dir);
+  // The last stage's end ends the run.
+  EXPECT_NE(summary.stop_reason.find("loading finished"), std::string::npos) << summary.stop_reason;
+  EXPECT_NEAR(summary.time, 5e-4, 1e-12);
+  const auto csv = mpmcd::analysis::read_time_series((dir / "out" / "block.csv").string());
+  const auto& t = csv.column("time");
+  const auto& top = csv.column("wall_top_stress");
+  const auto& bottom = csv.column("wall_bottom_stress");
+  const auto& left = csv.column("wall_left_stress");
+  const auto& goal = csv.column("wall_top_target");
+  const auto& h_box = csv.column("h");
+  const auto& lw = csv.column("lw_syy");
+  ASSERT_GT(csv.rows(), 400u);
+  int checked = 0;
+  double worst = 0;
+  for (std::size_t i = 0; i < csv.rows(); ++i) {
+    // The target follows its ramp, then holds.
+    EXPECT_NEAR(goal[i], target * std::min(t[i] / ramp, 1.0), 1e-9 * std::fabs(target)) << t[i];
+    if (t[i] < settled) continue;
+    ++checked;
+    const double s = h_box[i] / kH0;  // the stretch reached
+    worst = std::max(worst, std::fabs(top[i] - target) / std::fabs(target));
+    EXPECT_NEAR(top[i], target, 0.01 * std::fabs(target)) << "top wall at t = " << t[i];
+    EXPECT_NEAR(bottom[i], target, 0.01 * std::fabs(target)) << "bottom wall at t = " << t[i];
+    EXPECT_NEAR(lw[i], target, 0.01 * std::fabs(target)) << "Love-Weber at t = " << t[i];
+    EXPECT_NEAR(sigma22(s), target, 0.01 * std::fabs(target)) << "closed form at s = " << s;
+    // The closed form of the reached stretch and the side walls (sigma11).
+    EXPECT_NEAR(top[i], sigma22(s), 1e-3 * std::fabs(target)) << t[i];
+    EXPECT_NEAR(left[i], sigma11(s), 0.01 * std::fabs(sigma11(s))) << t[i];
+  }
+  EXPECT_GT(checked, 90);
+  std::printf("  servo block: worst |sigma_top - target| / |target| after %.2g s: %.3e\n", settled,
+              worst);
+  // Every point's sigma22 at the end (the final checkpoint holds them).
+  const ck::State s = ck::read(summary.checkpoint);
+  const double s_end = h_box.back() / kH0;
+  double worst_point = 0;
+  for (std::size_t p = 0; p < s.points(); ++p)
+    worst_point = std::max(worst_point, std::fabs(s.sigma[4 * p + 3] - target) / std::fabs(target));
+  EXPECT_LT(worst_point, 0.01);
+  std::printf("  final s = %.6f: sigma22(s) = %.6g Pa, worst point sigma22 error %.3e\n", s_end,
+              sigma22(s_end), worst_point);
+}
+
+namespace {
+
+// The coarse block (h = 0.2 mm, 100 points) driven through four stages that end on a stress, a
+// time, and two strains; `every` [s] CSV interval.
+std::string staged_input(const std::string& checkpoint = "") {
+  return block_input(
+      2e-4, 2e-6, 2e-3,
+      "[loading]\n"
+      "[[loading.stages]]\nname = \"approach\"\nuntil = { stress = -2e5, wall = \"top\" }\n"
+      "[[loading.stages.walls]]\nname = \"top\"\nvelocity = [0.0, -0.5]\n"
+      "[[loading.stages]]\nname = \"hold\"\nuntil = { time = 1e-4 }\n"
+      "[[loading.stages.walls]]\nname = \"top\"\nstress = -2e5\n"
+      "[[loading.stages]]\nname = \"unload\"\nuntil = { strain = -0.01 }\n"
+      "[[loading.stages.walls]]\nname = \"top\"\nvelocity = [0.0, 0.5]\n"
+      "[[loading.stages]]\nname = \"reload\"\nramp = 2e-5\nuntil = { strain = -0.02 }\n"
+      "[[loading.stages.walls]]\nname = \"top\"\nvelocity = [0.0, -0.25]\n" +
+          checkpoint);
+}
+
+}  // namespace
+
+TEST(Loading, StagesEndOnTheirConditionsAndRampsFollowTheirLine) {
+  const fs::path dir = scratch("stages");
+  const auto summary = run(staged_input(), dir);
+  EXPECT_NE(summary.stop_reason.find("loading finished: loading stage 4 ('reload')"),
+            std::string::npos)
+      << summary.stop_reason;
+  EXPECT_NE(summary.stop_reason.find("until.strain"), std::string::npos) << summary.stop_reason;
+  const auto csv = mpmcd::analysis::read_time_series((dir / "out" / "block.csv").string());
+  const auto& t = csv.column("time");
+  const auto& stage = csv.column("stage");
+  const auto& top = csv.column("wall_top_stress");
+  const auto& eps = csv.column("eps");
+  const auto& vy = csv.column("wall_top_vy");
+  const auto& goal = csv.column("wall_top_target");
+  // Each row's stage is the one that steps after it: the row where a stage ends shows the next.
+  std::vector<std::size_t> first(6, 0);  // first row of stages 1..5 (5: none)
+  for (std::size_t i = 1; i < csv.rows(); ++i) {
+    ASSERT_GE(stage[i], stage[i - 1]);
+    if (stage[i] != stage[i - 1]) first[static_cast<std::size_t>(stage[i])] = i;
+  }
+  ASSERT_GT(first[2], 0u);
+  ASSERT_GT(first[3], first[2]);
+  ASSERT_GT(first[4], first[3]);
+  // 1: the top wall at -0.5 m/s until its stress crosses -2e5 Pa (not before).
+  for (std::size_t i = 1; i < first[2]; ++i) {
+    EXPECT_EQ(vy[i], -0.5);
+    EXPECT_GT(top[i], -2e5) << t[i];
+    EXPECT_TRUE(std::isnan(goal[i]));  // velocity control: no target stress
+  }
+  EXPECT_LE(top[first[2]], -2e5);
+  // 2: stress control for exactly 1e-4 s (its steps end on the stage's end), target -2e5 Pa.
+  EXPECT_NEAR(t[first[3]] - t[first[2]], 1e-4, 1e-12);
+  for (std::size_t i = first[2]; i < first[3]; ++i) EXPECT_EQ(goal[i], -2e5);
+  // 3: unloading at +0.5 m/s until eps crosses -0.01 upward.
+  for (std::size_t i = first[3] + 1; i <= first[4]; ++i) EXPECT_EQ(vy[i], 0.5);
+  for (std::size_t i = first[3]; i < first[4]; ++i) EXPECT_LT(eps[i], -0.01) << t[i];
+  EXPECT_GE(eps[first[4]], -0.01);
+  // 4: the velocity ramps from +0.5 to -0.25 m/s over 2e-5 s (the step's velocity is the ramp's
+  // value at the step's end), then holds until eps crosses -0.02 downward: the last row.
+  const double t4 = t[first[4]];
+  for (std::size_t i = first[4] + 1; i < csv.rows(); ++i) {
+    const double share = std::min((t[i] - t4) / 2e-5, 1.0);
+    EXPECT_NEAR(vy[i], 0.5 + share * (-0.75), 1e-9) << t[i];
+  }
+  for (std::size_t i = first[4]; i + 1 < csv.rows(); ++i) EXPECT_GT(eps[i], -0.02) << t[i];
+  EXPECT_LE(eps.back(), -0.02);
+  EXPECT_EQ(stage.back(), 4);
+}
+
+// A run stopped in the middle of the hold stage (stress control) and restarted from its checkpoint
+// writes the same CSV rows, byte for byte, and ends in the same state as the uninterrupted run.
+TEST(Loading, RestartMidStageIsBitwise) {
+  const fs::path dir = scratch("restart");
+  fs::create_directories(dir / "full");
+  fs::create_directories(dir / "split");
+  const auto full = run(staged_input(), dir / "full");
+  ASSERT_FALSE(full.interrupted);
+  // The hold stage starts after about 27 steps of approach and lasts 50 steps.
+  const auto first = run(staged_input(), dir / "split", 50);
+  ASSERT_TRUE(first.interrupted);
+  const ck::State mid = ck::read(first.checkpoint);
+  ASSERT_EQ(mid.loading_stage.size(), 5u);
+  EXPECT_EQ(mid.loading_stage[0], 1.0) << "not in the hold stage";
+  EXPECT_EQ(mid.loading_control.at(1), 1) << "the top wall is not stress-controlled";
+  const auto restart = mpmcd::app::load_restart(first.checkpoint, "");
+  mpmcd::app::RunOptions ropt;
+  ropt.threads = 1;
+  ropt.quiet = true;
+  ropt.restart = first.checkpoint;
+  const auto second = mpmcd::app::run_simulation(restart.config, ropt, &restart.state);
+  EXPECT_EQ(second.steps, full.steps);
+  EXPECT_EQ(second.stop_reason, full.stop_reason);
+  EXPECT_TRUE(read(dir / "full" / "out" / "block.csv") == read(dir / "split" / "out" / "block.csv"))
+      << "CSV rows differ";
+  const ck::State a = ck::read(full.checkpoint), b = ck::read(second.checkpoint);
+  EXPECT_EQ(ck::payload_checksum(a), ck::payload_checksum(b));
+  EXPECT_EQ(a.loading_wall, b.loading_wall);
+  EXPECT_EQ(a.wall_point, b.wall_point);
+}
