@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "../../support/scratch.hpp"
 #include "mpmcd/checkpoint/checkpoint.hpp"
 #include "mpmcd/core/errors.hpp"
 
@@ -24,10 +25,7 @@ namespace ck = mpmcd::checkpoint;
 namespace {
 
 fs::path scratch(const std::string& name) {
-  fs::path p = fs::temp_directory_path() / ("mpmcd_ckpt_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
+  return mpmcd::test_support::scratch_dir("ckpt", name);
 }
 
 // A small consistent state: 2 grains of 3 and 2 points, one warm-start impulse, one wall.

@@ -19,6 +19,7 @@
 #include "mpmcd/core/openmp_env.hpp"
 
 #include "../../support/cli_runner.hpp"
+#include "../../support/scratch.hpp"
 
 namespace fs = std::filesystem;
 
@@ -31,19 +32,8 @@ std::string example() {
   return std::string(MPMCD_SOURCE_DIR) + "/examples/squeezed_disk/squeezed_disk.toml";
 }
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 fs::path scratch(const std::string& name) {
-  // The pid keeps concurrent test runs (other build trees on the machine) apart.
-  fs::path p = fs::temp_directory_path() / ("mpmcd_cli_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
+  return mpmcd::test_support::scratch_dir("cli", name);
 }
 
 // Writes an input whose only grain is given by `grain` and time section by `time`.
@@ -101,10 +91,10 @@ TEST(Cli, RunWritesSeriesCsvAndStampedInputCopy) {
   const Result r = run("run -q " + example() + " -o " + dir.string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(r.output.empty()) << "--quiet printed: " << r.output;
-  const std::string copy = read(dir / "input.toml");
+  const std::string copy = mpmcd::test_support::read_file(dir / "input.toml");
   EXPECT_EQ(copy.rfind("# run by mpmcd ", 0), 0u);
-  EXPECT_NE(copy.find(read(example())), std::string::npos);
-  const std::string pvd = read(dir / "squeezed_disk.pvd");
+  EXPECT_NE(copy.find(mpmcd::test_support::read_file(example())), std::string::npos);
+  const std::string pvd = mpmcd::test_support::read_file(dir / "squeezed_disk.pvd");
   int frames = 0, contact_frames = 0;  // point snapshots and contact snapshots (walls)
   for (auto& e : fs::directory_iterator(dir)) {
     if (e.path().extension() != ".vtu") continue;
@@ -192,7 +182,8 @@ TEST(Cli, PointLeavingTheGridStopsWithExit3) {
 TEST(Cli, ListPrintsInputReferenceAndLaws) {
   const Result a = run("list input");
   EXPECT_EQ(a.code, 0);
-  EXPECT_EQ(a.output, read(fs::path(MPMCD_SOURCE_DIR) / "docs" / "input.md"));
+  EXPECT_EQ(a.output,
+            mpmcd::test_support::read_file(fs::path(MPMCD_SOURCE_DIR) / "docs" / "input.md"));
   const Result b = run("list laws");
   EXPECT_EQ(b.code, 0);
   EXPECT_NE(b.output.find("neo_hookean"), std::string::npos);
@@ -338,7 +329,7 @@ TEST(Cli, ReusedOutputFolderIsRefusedUnlessOverwrite) {
   ASSERT_EQ(run("run -q " + (dir / "five.toml").string()).code, 0);
   const auto first = names_in(dir / "out");
   EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_000005.vtu"));
-  const std::string csv = read(dir / "out" / "mpmcd.csv");
+  const std::string csv = mpmcd::test_support::read_file(dir / "out" / "mpmcd.csv");
   const fs::path three = write_input(dir, disk, "[time]\ndt = 1e-5\nend_time = 3e-5\n");
   const Result again = run("run -q " + three.string());
   EXPECT_EQ(again.code, 2) << again.output;
@@ -349,7 +340,7 @@ TEST(Cli, ReusedOutputFolderIsRefusedUnlessOverwrite) {
   EXPECT_NE(again.output.find("give --overwrite to remove them first"), std::string::npos)
       << again.output;
   EXPECT_EQ(names_in(dir / "out"), first);
-  EXPECT_EQ(read(dir / "out" / "mpmcd.csv"), csv);
+  EXPECT_EQ(mpmcd::test_support::read_file(dir / "out" / "mpmcd.csv"), csv);
   // --overwrite: only the new run's files, none of the longer first run's snapshots.
   const Result over = run("run -q --overwrite " + three.string());
   EXPECT_EQ(over.code, 0) << over.output;
@@ -357,7 +348,8 @@ TEST(Cli, ReusedOutputFolderIsRefusedUnlessOverwrite) {
   EXPECT_FALSE(fs::exists(dir / "out" / "mpmcd_000005.vtu"));
   EXPECT_FALSE(fs::exists(dir / "out" / "mpmcd_checkpoint_000000005.h5"));
   EXPECT_TRUE(fs::exists(dir / "out" / "mpmcd_000003.vtu"));
-  EXPECT_EQ(read(dir / "out" / "mpmcd.pvd").find("mpmcd_000004.vtu"), std::string::npos);
+  EXPECT_EQ(mpmcd::test_support::read_file(dir / "out" / "mpmcd.pvd").find("mpmcd_000004.vtu"),
+            std::string::npos);
   // A run of another name: refused (the folder holds a run), then it replaces the old one.
   const fs::path other = write_input(dir, "[simulation]\nname = \"other\"\n" + disk,
                                      "[time]\ndt = 1e-5\nend_time = 2e-5\n");
@@ -406,7 +398,7 @@ TEST(Cli, RestartIntoAnotherFolderHoldsTheWholeRun) {
   ASSERT_EQ(r.code, 0) << r.output;
   const auto listed = [](const fs::path& pvd) {
     std::vector<std::string> files;
-    const std::string text = read(pvd);
+    const std::string text = mpmcd::test_support::read_file(pvd);
     for (std::size_t at = text.find("file=\""); at != std::string::npos;
          at = text.find("file=\"", at + 1))
       files.push_back(text.substr(at + 6, text.find('"', at + 6) - at - 6));
@@ -416,7 +408,9 @@ TEST(Cli, RestartIntoAnotherFolderHoldsTheWholeRun) {
     const auto files = listed(dir / "moved" / series);
     EXPECT_EQ(files.size(), 11u) << series;
     for (const auto& f : files) EXPECT_TRUE(fs::exists(dir / "moved" / f)) << f << " listed";
-    EXPECT_EQ(read(dir / "moved" / series), read(dir / "full" / series)) << series;
+    EXPECT_EQ(mpmcd::test_support::read_file(dir / "moved" / series),
+              mpmcd::test_support::read_file(dir / "full" / series))
+        << series;
   }
   auto outputs = [](const fs::path& d) {
     std::vector<std::string> out;
@@ -426,7 +420,9 @@ TEST(Cli, RestartIntoAnotherFolderHoldsTheWholeRun) {
   };
   EXPECT_EQ(outputs(dir / "moved"), outputs(dir / "full"));
   for (const auto& f : outputs(dir / "full"))
-    EXPECT_EQ(read(dir / "moved" / f), read(dir / "full" / f)) << f;
+    EXPECT_EQ(mpmcd::test_support::read_file(dir / "moved" / f),
+              mpmcd::test_support::read_file(dir / "full" / f))
+        << f;
   // A restart into a folder holding another run is refused like a new run.
   const Result taken =
       run("run -q -t 1 --restart " + ckpt.string() + " -o " + (dir / "full").string());
@@ -603,7 +599,7 @@ TEST(Cli, GrainOutputsAtSnapshotTimes) {
   const fs::path dir = scratch("grains");
   const fs::path src = fs::path(MPMCD_SOURCE_DIR) / "tests" / "verification" / "compaction";
   fs::copy_file(src / "packing.csv", dir / "packing.csv");
-  std::string text = read(src / "compaction.toml");
+  std::string text = mpmcd::test_support::read_file(src / "compaction.toml");
   text.replace(text.find("end_time = 4e-4"), 15, "end_time = 2e-4");
   text.replace(text.find("vtu_interval = 2e-5"), 19, "vtu_interval = 1e-4\ngrains = true");
   std::ofstream(dir / "grains.toml") << text;

@@ -20,6 +20,7 @@
 #include "mpmcd/io/load_config.hpp"
 
 #include "../../support/cli_runner.hpp"
+#include "../../support/scratch.hpp"
 
 namespace fs = std::filesystem;
 using mpmcd::analysis::TimeSeries;
@@ -30,10 +31,7 @@ using mpmcd::test_support::Result;
 using mpmcd::test_support::run;
 
 fs::path scratch(const std::string& name) {
-  fs::path p = fs::temp_directory_path() / ("mpmcd_compaction_" + name);
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
+  return mpmcd::test_support::scratch_dir("compaction", name);
 }
 
 constexpr double kPhiStop = 0.8;  // [stop] phi of compaction.toml

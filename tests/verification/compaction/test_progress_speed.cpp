@@ -22,6 +22,7 @@
 #include "mpmcd/io/load_config.hpp"
 
 #include "../../support/cli_runner.hpp"
+#include "../../support/scratch.hpp"
 
 namespace fs = std::filesystem;
 
@@ -31,12 +32,7 @@ using mpmcd::test_support::Result;
 using mpmcd::test_support::run;
 
 fs::path scratch(const std::string& name) {
-  // The pid keeps concurrent test runs (other build trees on the machine) apart.
-  fs::path p =
-      fs::temp_directory_path() / ("mpmcd_progress_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
+  return mpmcd::test_support::scratch_dir("progress", name);
 }
 
 std::string tiny_input() {

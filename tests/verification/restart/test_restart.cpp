@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "../../support/scratch.hpp"
 #include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/simulation.hpp"
 #include "mpmcd/checkpoint/checkpoint.hpp"
@@ -31,19 +32,7 @@ namespace ck = mpmcd::checkpoint;
 namespace {
 
 fs::path scratch(const std::string& name) {
-  // The pid keeps concurrent test runs (other build trees on the machine) apart.
-  fs::path p =
-      fs::temp_directory_path() / ("mpmcd_restart_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return mpmcd::test_support::scratch_dir("restart", name);
 }
 
 // Two gel disks thrown at each other in a box of three walls under gravity: they collide at
@@ -97,7 +86,8 @@ void expect_identical_runs(const fs::path& a, const fs::path& b, std::int64_t st
   EXPECT_FALSE(sa.warm_node.empty()) << "the case should end with contacts";
   EXPECT_EQ(ck::payload_checksum(sa), ck::payload_checksum(sb));
   // No timestamps in the file: the same state gives the same bytes.
-  EXPECT_TRUE(read(a / ck::file_name("pair", steps)) == read(b / ck::file_name("pair", steps)))
+  EXPECT_TRUE(mpmcd::test_support::read_file(a / ck::file_name("pair", steps)) ==
+              mpmcd::test_support::read_file(b / ck::file_name("pair", steps)))
       << "final checkpoint files differ";
   int files = 0;
   for (const auto& e : fs::directory_iterator(a)) {
@@ -107,7 +97,8 @@ void expect_identical_runs(const fs::path& a, const fs::path& b, std::int64_t st
     ++files;
     const fs::path other = b / e.path().filename();
     ASSERT_TRUE(fs::exists(other)) << other;
-    EXPECT_TRUE(read(e.path()) == read(other)) << e.path().filename() << " differs";
+    EXPECT_TRUE(mpmcd::test_support::read_file(e.path()) == mpmcd::test_support::read_file(other))
+        << e.path().filename() << " differs";
   }
   for (const auto& e : fs::directory_iterator(b))
     EXPECT_TRUE(fs::exists(a / e.path().filename()) || e.path().extension() == ".h5" ||
@@ -168,7 +159,7 @@ fs::path reference(const fs::path& dir, int steps, const std::string& checkpoint
   const fs::path out = dir / "ref";
   EXPECT_EQ(run_binary({"run", "-q", "-t", "1", in.string(), "-o", out.string()}, dir / "ref.log"),
             0)
-      << read(dir / "ref.log");
+      << mpmcd::test_support::read_file(dir / "ref.log");
   return in;
 }
 
@@ -220,7 +211,7 @@ TEST(Restart, SigtermThenResumeIsBitwise) {
   ASSERT_TRUE(wait_for([&] { return csv_rows(out / "pair.csv") >= n / 4; }));
   kill(pid, SIGTERM);
   const int code = wait_exit(pid);
-  const std::string log = read(dir / "interrupted.log");
+  const std::string log = mpmcd::test_support::read_file(dir / "interrupted.log");
   ASSERT_EQ(code, 4) << log;
   EXPECT_NE(log.find("interrupted (SIGTERM) at step "), std::string::npos) << log;
   const auto ckpts = ck::list(out.string(), "pair");
@@ -234,7 +225,7 @@ TEST(Restart, SigtermThenResumeIsBitwise) {
   // Resume, naming the input too (it must be the same text).
   const int rc = run_binary({"run", "-q", "-t", "1", in.string(), "--restart", ckpts.back()},
                             dir / "resume.log");
-  ASSERT_EQ(rc, 0) << read(dir / "resume.log");
+  ASSERT_EQ(rc, 0) << mpmcd::test_support::read_file(dir / "resume.log");
   expect_identical_runs(dir / "ref", out, n);
 }
 
@@ -260,7 +251,7 @@ TEST(Restart, SigkillLeavesALoadableCheckpoint) {
   EXPECT_EQ(s.step % 3, 0);
   const int rc =
       run_binary({"run", "-q", "-t", "1", "--restart", ckpts.back()}, dir / "resume.log");
-  ASSERT_EQ(rc, 0) << read(dir / "resume.log");
+  ASSERT_EQ(rc, 0) << mpmcd::test_support::read_file(dir / "resume.log");
   expect_identical_runs(dir / "ref", out, n);
 }
 
@@ -269,9 +260,10 @@ TEST(Restart, SigkillLeavesALoadableCheckpoint) {
 TEST(Restart, DamagedCheckpointOrForeignInputExits2) {
   const fs::path dir = scratch("damaged");
   const fs::path in = write_case(dir, 10, "");
-  ASSERT_EQ(run_binary({"run", "-q", in.string()}, dir / "run.log"), 0) << read(dir / "run.log");
+  ASSERT_EQ(run_binary({"run", "-q", in.string()}, dir / "run.log"), 0)
+      << mpmcd::test_support::read_file(dir / "run.log");
   const fs::path good = dir / "out" / ck::file_name("pair", 10);
-  const std::string bytes = read(good);
+  const std::string bytes = mpmcd::test_support::read_file(good);
   ASSERT_GT(bytes.size(), 1000u);
   std::ofstream(dir / "truncated.h5", std::ios::binary) << bytes.substr(0, bytes.size() - 100);
   std::string flipped = bytes;
@@ -291,17 +283,18 @@ TEST(Restart, DamagedCheckpointOrForeignInputExits2) {
       {"absent.h5", "no such file"}};
   for (const auto& [file, fragment] : cases) {
     const int rc = run_binary({"run", "--restart", (dir / file).string()}, dir / "bad.log");
-    const std::string log = read(dir / "bad.log");
+    const std::string log = mpmcd::test_support::read_file(dir / "bad.log");
     EXPECT_EQ(rc, 2) << file << ": " << log;
     EXPECT_NE(log.find("checkpoint refused: "), std::string::npos) << log;
     EXPECT_NE(log.find(fragment), std::string::npos) << log;
   }
   // Another input: refused, the checkpoint is not loaded.
   const fs::path other = dir / "other.toml";
-  std::ofstream(other) << read(in) << "# edited\n";
+  std::ofstream(other) << mpmcd::test_support::read_file(in) << "# edited\n";
   EXPECT_EQ(run_binary({"run", other.string(), "--restart", good.string()}, dir / "bad.log"), 2);
-  EXPECT_NE(read(dir / "bad.log").find("is not the one checkpoint"), std::string::npos)
-      << read(dir / "bad.log");
+  EXPECT_NE(mpmcd::test_support::read_file(dir / "bad.log").find("is not the one checkpoint"),
+            std::string::npos)
+      << mpmcd::test_support::read_file(dir / "bad.log");
   // Nothing to run.
   EXPECT_EQ(run_binary({"run"}, dir / "bad.log"), 2);
 }
@@ -313,22 +306,23 @@ TEST(Restart, AnotherThreadCountPrintsANote) {
   const fs::path in = write_case(dir, 8, "");
   ASSERT_EQ(run_binary({"run", "-q", "-t", "2", in.string(), "--stop-after", "4"}, dir / "a.log"),
             4)
-      << read(dir / "a.log");
+      << mpmcd::test_support::read_file(dir / "a.log");
   const fs::path ckpt = dir / "out" / ck::file_name("pair", 4);
   EXPECT_EQ(ck::read(ckpt.string()).threads, 2);
   ASSERT_EQ(run_binary({"run", "-q", "-t", "1", "--restart", ckpt.string()}, dir / "b.log"), 0)
-      << read(dir / "b.log");
-  EXPECT_NE(read(dir / "b.log")
+      << mpmcd::test_support::read_file(dir / "b.log");
+  EXPECT_NE(mpmcd::test_support::read_file(dir / "b.log")
                 .find("note: the checkpoint was written with 2 thread(s) per rank, "
                       "this run has 1: the run goes on, but bitwise equality with "
                       "an uninterrupted run is promised only with the same thread "
                       "count (-t 2)"),
             std::string::npos)
-      << read(dir / "b.log");
+      << mpmcd::test_support::read_file(dir / "b.log");
   EXPECT_EQ(ck::read((dir / "out" / ck::file_name("pair", 8)).string()).threads, 1);
   ASSERT_EQ(run_binary({"run", "-q", "-t", "2", "--restart", ckpt.string()}, dir / "c.log"), 0)
-      << read(dir / "c.log");
-  EXPECT_EQ(read(dir / "c.log").find("note:"), std::string::npos) << read(dir / "c.log");
+      << mpmcd::test_support::read_file(dir / "c.log");
+  EXPECT_EQ(mpmcd::test_support::read_file(dir / "c.log").find("note:"), std::string::npos)
+      << mpmcd::test_support::read_file(dir / "c.log");
 }
 
 // Checkpoint format 7 added the wall loading; a format 6 file (written by the mpmcd before it,
@@ -340,13 +334,14 @@ TEST(Restart, AFormat6CheckpointStillContinuesBitwise) {
   const fs::path ckpt = dir / "tiny_checkpoint_000000001.h5";
   fs::copy_file(src / "tiny_checkpoint_000000001.h5", ckpt);
   fs::copy_file(src / "tiny_step1.csv", dir / "tiny.csv");
-  ASSERT_EQ(read(ckpt).rfind("MPMCD-CHECKPOINT 6\n", 0), 0u);
+  ASSERT_EQ(mpmcd::test_support::read_file(ckpt).rfind("MPMCD-CHECKPOINT 6\n", 0), 0u);
   const ck::State s = ck::read(ckpt.string());
   EXPECT_EQ(s.step, 1);
   EXPECT_TRUE(s.loading_stage.empty() && s.loading_control.empty() && s.loading_wall.empty());
   const int rc = run_binary({"run", "-q", "-t", "1", "--restart", ckpt.string()}, dir / "run.log");
-  ASSERT_EQ(rc, 0) << read(dir / "run.log");
-  EXPECT_TRUE(read(dir / "tiny.csv") == read(src / "tiny_full.csv"))
-      << read(dir / "tiny.csv") << "\nexpected\n"
-      << read(src / "tiny_full.csv");
+  ASSERT_EQ(rc, 0) << mpmcd::test_support::read_file(dir / "run.log");
+  EXPECT_TRUE(mpmcd::test_support::read_file(dir / "tiny.csv") ==
+              mpmcd::test_support::read_file(src / "tiny_full.csv"))
+      << mpmcd::test_support::read_file(dir / "tiny.csv") << "\nexpected\n"
+      << mpmcd::test_support::read_file(src / "tiny_full.csv");
 }

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "../../support/scratch.hpp"
 #include "mpmcd/analysis/time_series.hpp"
 #include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/simulation.hpp"
@@ -30,18 +31,7 @@ constexpr double kLambda = 3e6, kMu = 1.5e6;  // the block's Neo-Hookean materia
 constexpr double kH0 = 1e-3;                  // the block's initial height and width [m]
 
 fs::path scratch(const std::string& name) {
-  // The pid keeps concurrent test runs (other build trees on the machine) apart.
-  fs::path p = fs::temp_directory_path() / ("mpmcd_servo_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return mpmcd::test_support::scratch_dir("servo", name);
 }
 
 // The block [0.5, 1.5] mm^2 between four walls touching it (uniaxial strain), cell size h [m],
@@ -244,7 +234,8 @@ TEST(Loading, RestartMidStageIsBitwise) {
   const auto second = mpmcd::app::run_simulation(restart.config, ropt, &restart.state);
   EXPECT_EQ(second.steps, full.steps);
   EXPECT_EQ(second.stop_reason, full.stop_reason);
-  EXPECT_TRUE(read(dir / "full" / "out" / "block.csv") == read(dir / "split" / "out" / "block.csv"))
+  EXPECT_TRUE(mpmcd::test_support::read_file(dir / "full" / "out" / "block.csv") ==
+              mpmcd::test_support::read_file(dir / "split" / "out" / "block.csv"))
       << "CSV rows differ";
   const ck::State a = ck::read(full.checkpoint), b = ck::read(second.checkpoint);
   EXPECT_EQ(ck::payload_checksum(a), ck::payload_checksum(b));
