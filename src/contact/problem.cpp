@@ -164,23 +164,9 @@ void free_velocity(const Problem<Dim>& p, const SlotVelocities<Dim>& v, const Co
 
 }  // namespace
 
-namespace {
-
-// Contacts grouped by the node of their slot B, each group in the serial order, as runs of
-// `order` from start[r] to start[r + 1]; runs of one phase (runs phase[k] to phase[k + 1]) share
-// no slot and no compliance group, so they are swept on the threads, the phases one after the
-// other. With the lumped operator (no compliance group) a slot belongs to one node and responds
-// to its own impulses only: one phase of independent per-node runs (docs/parallel.md). When
-// groups couple the nodes, each node's contacts are a run and the runs are coloured greedily, in
-// node order, so that no two runs of a colour touch the same group or lumped slot (multicolour
-// Gauss-Seidel): one phase per colour. Either way the result does not depend on the thread count.
-struct NodeRuns {
-  std::vector<std::int32_t> order, start, phase;
-};
-
 template <int Dim>
-NodeRuns node_runs(const Problem<Dim>& p) {
-  NodeRuns runs;
+SweepOrder sweep_order(const Problem<Dim>& p) {
+  SweepOrder runs;
   const auto n = static_cast<std::int32_t>(p.contacts.size());
   runs.order.resize(static_cast<std::size_t>(n));
   for (std::int32_t c = 0; c < n; ++c) runs.order[c] = c;
@@ -244,6 +230,8 @@ NodeRuns node_runs(const Problem<Dim>& p) {
   runs.order = std::move(order);
   return runs;
 }
+
+namespace {
 
 // One sweep: each contact solved exactly with the others' current impulses (method.md §4), in
 // the serial order within a node; the nodes on the threads (the same impulses for any count).
@@ -367,7 +355,7 @@ bool solve_node_block(Problem<Dim>& p, SlotVelocities<Dim>& v, const std::int32_
 }
 
 template <int Dim>
-void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const NodeRuns& runs, StageTimers* timers,
+void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const SweepOrder& runs, StageTimers* timers,
            double omega, bool node_blocks, bool threads) {
   const ThreadedRegion threaded(timers, threads);
   for (std::size_t ph = 0; ph + 1 < runs.phase.size(); ++ph)
@@ -415,7 +403,8 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& 
     return r;
   }
   auto v = slot_velocities(p, can_thread);
-  const NodeRuns runs = node_runs(p);
+  const SweepOrder own = settings.order ? SweepOrder{} : sweep_order(p);
+  const SweepOrder& runs = settings.order ? *settings.order : own;
   const double work = static_cast<double>(p.contacts.size());
   while (r.sweeps < settings.max_sweeps) {
     const bool threads = tuner ? tuner->threaded() : can_thread;
@@ -642,6 +631,7 @@ Problem<Dim> read_problem(const std::string& path) {
   template Vec<D> local_solution<D>(const Vec<D>&, const Mat<D>&, const Vec<D>&, double, double); \
   template double error<D>(const Problem<D>&);                                                    \
   template std::vector<Vec<D>> net_impulses<D>(const Problem<D>&);                                \
+  template SweepOrder sweep_order<D>(const Problem<D>&);                                          \
   template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&);                        \
   template void error_terms<D>(const Problem<D>&, double&, double&, StageTimers*);                \
   template GsResult solve_gauss_seidel<D>(Problem<D>&, const GsSettings&, const ErrorReduce&);    \

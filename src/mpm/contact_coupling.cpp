@@ -240,7 +240,13 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   if (stalled_dir) given = problem_;
   {
     ScopedStage t(&timers_, "contact.gs");
-    r = contact::solve_gauss_seidel(problem_, gs_settings());
+    if (!sweep_order_ready_) {
+      sweep_order_ = contact::sweep_order(problem_);
+      sweep_order_ready_ = true;
+    }
+    contact::GsSettings gs = gs_settings();
+    gs.order = &sweep_order_;
+    r = contact::solve_gauss_seidel(problem_, gs);
   }
   if (stalled_dir && !r.converged) {
     static int written = 0;

@@ -140,6 +140,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   problem_.dt = dt;
   problem_.slots.clear();
   problem_.contacts.clear();
+  sweep_order_ready_ = false;
   slot_ref_.clear();
   slot_next_.clear();
   slot_start_.assign(1, 0);

@@ -55,6 +55,22 @@ struct Problem {
   std::vector<Group> groups;           ///< compliance groups (empty: all slots lumped)
 };
 
+/// The order of a Gauss-Seidel sweep over a problem's contacts: the contacts grouped by the node
+/// of their slot B, each node's in the serial order, as runs of `order` from start[r] to
+/// start[r + 1]; the runs of one phase (runs phase[k] to phase[k + 1]) share no slot and no
+/// compliance group, so they are swept on the threads, the phases one after the other. With the
+/// lumped operator (no compliance group) a slot belongs to one node and responds to its own
+/// impulses only: one phase of independent per-node runs (docs/parallel.md). When groups couple
+/// the nodes, each node's contacts are a run and the runs are coloured greedily, in node order,
+/// so that no two runs of a colour touch the same group or lumped slot (multicolour
+/// Gauss-Seidel): one phase per colour. Either way the result does not depend on the thread
+/// count. It depends only on the contacts' slots and the groups, not on the impulses.
+struct SweepOrder {
+  std::vector<std::int32_t> order;  ///< contact indices, run after run
+  std::vector<std::int32_t> start;  ///< run r is order[start[r] .. start[r + 1])
+  std::vector<std::int32_t> phase;  ///< phase k is runs phase[k] .. phase[k + 1]
+};
+
 /// Gauss-Seidel settings.
 struct GsSettings {
   double tolerance = 1e-8;  ///< stop when error(problem) <= tolerance [-]
@@ -73,6 +89,9 @@ struct GsSettings {
   /// same impulses either way: core/thread_tuner.hpp); null: the threads whenever the problem is
   /// large enough.
   ThreadTuner* tuner = nullptr;
+  /// The problem's sweep order (sweep_order) when the caller keeps it for several solves of the
+  /// same contacts and groups (the Newton iterations of a step); null: made by each solve.
+  const SweepOrder* order = nullptr;
 };
 
 /// Gauss-Seidel outcome.
@@ -117,6 +136,10 @@ std::vector<Vec<Dim>> net_impulses(const Problem<Dim>& problem);
 /// stays 0).
 template <int Dim>
 double error(const Problem<Dim>& problem);
+
+/// The sweep order of problem's contacts and groups (SweepOrder).
+template <int Dim>
+SweepOrder sweep_order(const Problem<Dim>& problem);
 
 /// Nonlinear Gauss-Seidel: sweeps the contacts in order, each solved exactly with the others'
 /// current impulses, until error(problem) <= tolerance or max_sweeps; starts from the impulses in

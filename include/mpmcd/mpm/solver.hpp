@@ -214,6 +214,10 @@ class ImplicitSolver {
     return gs;
   }
   ThreadTuner gs_tuner_;
+  // The sweep order of this step's contacts and groups, made at the step's first Gauss-Seidel
+  // solve and kept for the later Newton iterations (the same contacts and groups).
+  contact::SweepOrder sweep_order_;
+  bool sweep_order_ready_ = false;
   // Slots this rank serves to others and asks from others (links_) [-].
   std::pair<std::size_t, std::size_t> link_sizes() const;
   // Items of the last contact detection on this rank [-].
