@@ -209,6 +209,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
     Entry A, B;
     Vec<Dim> normal;
     double gap;
+    Vec<Dim> warm;  // the previous step's impulse of this contact (warm start)
   };
   std::vector<std::vector<Candidate>> found(shared.size());
   const auto nshared = static_cast<std::int64_t>(shared.size());
@@ -277,7 +278,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
           }
           gap = std::max(0.0, gap);
         }
-        found[i].push_back({A, B, normal, gap});
+        found[i].push_back({A, B, normal, gap, warm(n, A.g, B.g)});
       }
   }
   threaded.done();
@@ -289,14 +290,59 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
       c.normal = f.normal;
       c.gap = f.gap;
       c.friction = cs.friction[grains_[f.A.g].material * cs.materials + grains_[f.B.g].material];
-      c.impulse = warm(shared[i], f.A.g, f.B.g);
+      c.impulse = f.warm;
       problem_.contacts.push_back(c);
     }
   // 3. Grain-wall contacts: grain nodes within wall_range cells of a wall; gap from the points.
+  // Node walls: each grain's candidates, gaps and warm starts on the threads, then the contacts in
+  // the serial order (wall, grain, node).
+  struct WallCandidate {
+    std::int32_t a;
+    double gap;
+    Vec<Dim> warm;
+  };
+  const std::size_t nw = cs.walls.size(), nlocal = local_.size();
+  std::vector<std::vector<WallCandidate>> wall_found(cs.wall_points ? 0 : nw * nlocal);
+  if (!cs.wall_points && nw > 0) {
+    const auto npairs = static_cast<std::int64_t>(nw * nlocal);
+    const ThreadedRegion threaded_walls(&timers_, npairs > 1);
+#pragma omp parallel for schedule(dynamic, 4) if (npairs > 1) reduction(+ : items)
+    for (std::int64_t k = 0; k < npairs; ++k) {
+      const std::size_t wi = static_cast<std::size_t>(k) / nlocal;
+      const std::size_t g = local_[static_cast<std::size_t>(k) % nlocal];
+      const Wall<Dim>& wall = cs.walls[wi];
+      const GrainWork& w = *work_[g];
+      for (std::size_t a = 0; a < w.m.size(); ++a) {
+        if (w.m[a] < w.contact_mass) continue;
+        if (dist && node_rank(w.node_global[a]) != me) continue;
+        const Vec<Dim> xn = grid_.node_position(grid_.node_coords(w.node_global[a]));
+        if (wall.distance(xn, time_) > cs.wall_range * h) continue;
+        items += 1.0 + (w.node_pts_start[a + 1] - w.node_pts_start[a]);
+        double gap = std::numeric_limits<double>::infinity(), ext = 0;
+        for (std::int32_t q = w.node_pts_start[a]; q < w.node_pts_start[a + 1]; ++q) {
+          const std::int64_t p = grains_[g].begin + w.node_pts[q];
+          const double e = extent(p, wall.normal);
+          ext = std::max(ext, e);
+          gap = std::min(gap, wall.distance(points_.x[p], time_) - e);
+        }
+        if (!std::isfinite(gap)) continue;
+        // A node inside the grain may approach the wall until one whole point domain (twice the
+        // largest half-extent e of its points along n) still fits between it and the wall:
+        // gap >= d_node - 2 e. Without the 2 e the points between it and the wall are pushed
+        // through by up to e (measured: up to 0.25 h, and the Hertz load sagging); with the
+        // points' gap alone the layer down to the first node row would move with the wall.
+        gap = std::max(gap, wall.distance(xn, time_) - 2 * ext);
+        wall_found[static_cast<std::size_t>(k)].push_back(
+            {static_cast<std::int32_t>(a), gap,
+             warm(w.node_global[a], -1 - static_cast<std::int32_t>(wi),
+                  static_cast<std::int32_t>(g))});
+      }
+    }
+  }
   for (std::size_t wi = 0; wi < cs.walls.size(); ++wi) {
     const Wall<Dim>& wall = cs.walls[wi];
-    for (std::size_t g : local_) {
-      const GrainWork& w = *work_[g];
+    for (std::size_t li = 0; li < nlocal; ++li) {
+      const std::size_t g = local_[li];
       if (cs.wall_points) {
         // Face contacts (ContactSettings::wall_points, docs/accuracy.md): per cell column
         // along the wall, the faces of the grain's points nearest the wall in that column (within
@@ -360,36 +406,16 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         }
         continue;
       }
-      for (std::size_t a = 0; a < w.m.size(); ++a) {
-        if (w.m[a] < w.contact_mass) continue;
-        if (dist && node_rank(w.node_global[a]) != me) continue;
-        const Vec<Dim> xn = grid_.node_position(grid_.node_coords(w.node_global[a]));
-        if (wall.distance(xn, time_) > cs.wall_range * h) continue;
-        items += 1.0 + (w.node_pts_start[a + 1] - w.node_pts_start[a]);
-        double gap = std::numeric_limits<double>::infinity(), ext = 0;
-        for (std::int32_t k = w.node_pts_start[a]; k < w.node_pts_start[a + 1]; ++k) {
-          const std::int64_t p = grains_[g].begin + w.node_pts[k];
-          const double e = extent(p, wall.normal);
-          ext = std::max(ext, e);
-          gap = std::min(gap, wall.distance(points_.x[p], time_) - e);
-        }
-        if (!std::isfinite(gap)) continue;
-        // A node inside the grain may approach the wall until one whole point domain (twice the
-        // largest half-extent e of its points along n) still fits between it and the wall:
-        // gap >= d_node - 2 e. Without the 2 e the points between it and the wall are pushed
-        // through by up to e (measured: up to 0.25 h, and the Hertz load sagging); with the
-        // points' gap alone the layer down to the first node row would move with the wall.
-        gap = std::max(gap, wall.distance(xn, time_) - 2 * ext);
+      for (const WallCandidate& f : wall_found[wi * nlocal + li]) {
         contact::Contact<Dim> c;
         c.a = -1;
         c.wall = static_cast<std::int32_t>(wi);
-        c.b = slot_of(static_cast<std::int32_t>(g), static_cast<std::int32_t>(a));
+        c.b = slot_of(static_cast<std::int32_t>(g), f.a);
         c.normal = wall.normal;
         c.wall_velocity = wall.velocity;
-        c.gap = std::max(0.0, gap);
+        c.gap = std::max(0.0, f.gap);
         c.friction = wall.friction;
-        c.impulse = warm(w.node_global[a], -1 - static_cast<std::int32_t>(wi),
-                         static_cast<std::int32_t>(g));
+        c.impulse = f.warm;
         problem_.contacts.push_back(c);
       }
     }
