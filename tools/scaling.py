@@ -42,8 +42,90 @@ ap.add_argument("--rebalance", type=float, default=1.01, help="partition: thresh
 ap.add_argument("--cpu-time", action="store_true",
                 help="stage timers in thread CPU time (shared machine: work without core waits)")
 ap.add_argument("--plot-only", action="store_true", help="redraw from scaling_runs.csv")
+ap.add_argument("--dense", nargs="+", metavar="CHECKPOINT",
+                help="instead of the slice: the dense-state benchmark (bench_compaction) on these "
+                     "checkpoints (tools/compaction_checkpoints.sh), threads --dense-threads, "
+                     "--repeat repetitions interleaved; writes dense_speedup.csv, dense_amdahl.csv, "
+                     "dense_scaling.png")
+ap.add_argument("--dense-threads", default="1,2", help="thread counts of --dense")
+ap.add_argument("--dense-steps", type=int, default=5, help="timed steps per repetition")
 a = ap.parse_args()
 os.makedirs(a.out, exist_ok=True)
+
+
+def dense_mode():
+    """Dense-state scaling (issue 16): bench_compaction's medians per checkpoint and thread count,
+    the speedup over 1 thread, and Amdahl's projection S(P) = 1 / (f + (1 - f) / P) with f the
+    one-thread time of the 2-thread step (one_thread_fraction x its step time) over the 1-thread
+    step. The exact grain compliance runs on one rank only, so P counts threads; the projection
+    is what f allows on more cores, not a measurement."""
+    bench_c = os.path.join(a.build, "bench", "bench_compaction")
+    cmd = [bench_c, *a.dense, "--threads", a.dense_threads, "--steps", str(a.dense_steps),
+           "--benchmark_counters_tabular=true", f"--benchmark_repetitions={max(a.repeat, 1)}",
+           "--benchmark_enable_random_interleaving=true"]
+    print(" ".join(cmd), flush=True)
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    lines = [l.split() for l in out.splitlines() if l.startswith(("Benchmark", "BM_"))]
+    names = lines[0][4:]
+    rows = {}
+    for r in lines[1:]:
+        # BM_DenseSteps/<grid>/threads:<n>/iterations:<k>/real_time[_median]
+        if a.repeat > 1 and not r[0].endswith("_median"):
+            continue
+        parts = r[0].split("/")
+        grid, threads = parts[1], int(parts[2].split(":")[1])
+        counters = dict(zip(names, r[6:]))
+        rows[(grid, threads)] = (float(r[1]), counters)
+    with open(os.path.join(a.out, "dense_speedup.csv"), "w") as f:
+        f.write("grid,threads,step_ms,speedup,efficiency,one_thread_fraction,contact_solve_share\n")
+        for (grid, t), (ms, c) in sorted(rows.items()):
+            s = rows[(grid, 1)][0] / ms if (grid, 1) in rows else float("nan")
+            f.write(f"{grid},{t},{ms:g},{s:.3f},{s / t:.3f},{c['one_thread_fraction']},"
+                    f"{c['contact.solve_share']}\n")
+    P = [1, 2, 4, 8, 16, 32, 60]
+    amdahl = {}
+    with open(os.path.join(a.out, "dense_amdahl.csv"), "w") as f:
+        f.write("grid,f," + ",".join(f"S{p}" for p in P) + "\n")
+        for grid in sorted({g for g, _ in rows}):
+            if (grid, 1) not in rows or (grid, 2) not in rows:
+                continue
+            ms2, c2 = rows[(grid, 2)]
+            fr = float(c2["one_thread_fraction"]) * ms2 / rows[(grid, 1)][0]
+            amdahl[grid] = fr
+            f.write(f"{grid},{fr:.4f}," + ",".join(f"{1 / (fr + (1 - fr) / p):.2f}" for p in P)
+                    + "\n")
+    print(open(os.path.join(a.out, "dense_speedup.csv")).read())
+    print(open(os.path.join(a.out, "dense_amdahl.csv")).read())
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(5.5, 4.2))
+        ax.plot([1, 60], [1, 60], "k-", lw=1, label="ideal")
+        xs = list(range(1, 61))
+        for grid, mark in zip(sorted(amdahl), "os^v"):
+            pts = sorted((t, rows[(grid, 1)][0] / ms) for (g, t), (ms, _) in rows.items()
+                         if g == grid)
+            ax.plot(*zip(*pts), mark, label=f"{grid}: measured (threads)")
+            fr = amdahl[grid]
+            ax.plot(xs, [1 / (fr + (1 - fr) / p) for p in xs], "--",
+                    label=f"{grid}: Amdahl, f = {100 * fr:.1f} %")
+        ax.set_xlabel("threads P")
+        ax.set_ylabel("speedup")
+        ax.set_xlim(0, 61)
+        ax.set_ylim(0, 61)
+        ax.set_title("paper compaction, dense state (cf. paper Fig. 2)")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(a.out, "dense_scaling.png"), dpi=130)
+        print("wrote", os.path.join(a.out, "dense_scaling.png"))
+    except ImportError:
+        print("matplotlib missing: no PNG")
+
+
+if a.dense:
+    dense_mode()
+    sys.exit(0)
 runs_csv = os.path.join(a.out, "scaling_runs.csv")
 bench = os.path.join(a.build, "bench", "bench_parallel")
 
