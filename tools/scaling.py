@@ -53,6 +53,19 @@ a = ap.parse_args()
 os.makedirs(a.out, exist_ok=True)
 
 
+def finish_speedup_plot(fig, ax, xlabel, title, name):
+    """Axes to 60 processes, labels, legend; saves <out>/<name> (both scaling figures)."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("speedup")
+    ax.set_xlim(0, 61)
+    ax.set_ylim(0, 61)
+    ax.set_title(title)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(a.out, name), dpi=130)
+    print("wrote", os.path.join(a.out, name))
+
+
 def dense_mode():
     """Dense-state scaling (issue 16): bench_compaction's medians per checkpoint and thread count,
     the speedup over 1 thread, and Amdahl's projection S(P) = 1 / (f + (1 - f) / P) with f the
@@ -110,15 +123,8 @@ def dense_mode():
             fr = amdahl[grid]
             ax.plot(xs, [1 / (fr + (1 - fr) / p) for p in xs], "--",
                     label=f"{grid}: Amdahl, f = {100 * fr:.1f} %")
-        ax.set_xlabel("threads P")
-        ax.set_ylabel("speedup")
-        ax.set_xlim(0, 61)
-        ax.set_ylim(0, 61)
-        ax.set_title("paper compaction, dense state (cf. paper Fig. 2)")
-        ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(os.path.join(a.out, "dense_scaling.png"), dpi=130)
-        print("wrote", os.path.join(a.out, "dense_scaling.png"))
+        finish_speedup_plot(fig, ax, "threads P", "paper compaction, dense state (cf. paper Fig. 2)",
+                            "dense_scaling.png")
     except ImportError:
         print("matplotlib missing: no PNG")
 
@@ -300,14 +306,7 @@ try:
            if r["ranks"] == "1" and r["threads"] != "1"]
     if thr:
         ax.plot(*zip(*sorted(thr)), "^", label="1 rank, threads")
-    ax.set_xlabel("processes P")
-    ax.set_ylabel("speedup")
-    ax.set_xlim(0, 61)
-    ax.set_ylim(0, 61)
-    ax.set_title("300-grain compaction slice (cf. paper Fig. 2)")
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(a.out, "scaling.png"), dpi=130)
-    print("wrote", os.path.join(a.out, "scaling.png"))
+    finish_speedup_plot(fig, ax, "processes P", "300-grain compaction slice (cf. paper Fig. 2)",
+                        "scaling.png")
 except ImportError:
     print("matplotlib missing: no PNG")
