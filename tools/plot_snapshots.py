@@ -2,7 +2,8 @@
 """Pictures like the paper's Figure 3: the grains of a run at chosen solid fractions Φ.
 
 Usage: plot_snapshots.py <run-folder> --phi 0.78 0.9 0.97 [--field grain|pressure|J]
-                         [-o out-folder] [--dots] [--squares] [--dpi 150]
+                         [-o out-folder] [--dots] [--squares] [--dpi 150] [--forces]
+                         [--format png pdf svg]
 
 For each Φ asked, takes the VTU snapshot of the run (series <name>.pvd) whose time is nearest to
 the CSV row (<name>.csv, column phi) with the nearest Φ, and draws every material point as its
@@ -10,8 +11,13 @@ domain (its initial square, side sqrt(V0), mapped by the deformation gradient es
 neighbours' motion since the first snapshot; --squares: a square of side sqrt(V)) so that grains
 look filled, coloured by grain (shuffled
 categorical colours) or by pressure [MPa]; the walls of input.toml are drawn as lines at that
-time; --dots adds the material points as black dots (as in the paper). Writes
-<out>/snapshot_phi<Φ>_<field>.png (default out = <run-folder>/snapshots) and prints what it took.
+time; --dots adds the material points as black dots (as in the paper). --forces draws the
+contact-force network over the grains (runs with [output] grains = true: the snapshot's
+<name>_forces_<n>.csv and <name>_grains_<n>.csv, docs/observables.md): a line between the
+centroids of each pair of grains in contact (from the contact point to the centroid for a wall),
+its width proportional to the normal force (the mean force draws 1.5 pt). Writes
+<out>/snapshot_phi<Φ>_<field>[_forces].<format> for each --format (default png; pdf and svg are
+vector) in <out> (default <run-folder>/snapshots) and prints what it took.
 Needs numpy and matplotlib (/usr/bin/python3 on Debian 12); no ParaView.
 """
 import argparse
@@ -26,7 +32,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.collections import PolyCollection  # noqa: E402
+from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from vtu_points import read_vtu  # noqa: E402
@@ -103,7 +109,32 @@ def domains(xy, arr, first):
     return out
 
 
-def draw(vtu, t, cfg, field, dots, title, png, dpi, first):
+def force_network(folder, name, vtu):
+    """(segments [mm], normal forces [N/m]) of the snapshot `vtu`'s contact pairs, from its grains
+    and forces CSVs; None when the run wrote none (no [output] grains = true)."""
+    m = re.search(r"_(\d+)\.vtu$", vtu)
+    if not m:
+        return None
+    gpath = os.path.join(folder, f"{name}_grains_{m.group(1)}.csv")
+    fpath = os.path.join(folder, f"{name}_forces_{m.group(1)}.csv")
+    if not (os.path.isfile(gpath) and os.path.isfile(fpath)):
+        return None
+    with open(gpath, newline="") as f:
+        centre = {int(r["grain"]): (float(r["x"]) * 1e3, float(r["y"]) * 1e3)
+                  for r in csv.DictReader(f)}
+    segs, fn = [], []
+    with open(fpath, newline="") as f:
+        for r in csv.DictReader(f):
+            a, b, force = int(r["a"]), int(r["b"]), float(r["fn"])
+            if force <= 0 or b not in centre:
+                continue
+            start = centre[a] if a >= 0 else (float(r["px"]) * 1e3, float(r["py"]) * 1e3)
+            segs.append((start, centre[b]))
+            fn.append(force)
+    return segs, np.array(fn)
+
+
+def draw(vtu, t, cfg, field, dots, title, paths, dpi, first, forces=None):
     pts, arr = read_vtu(vtu)
     xy = pts[:, :2] * 1e3  # mm
     half = 0.5 * np.sqrt(arr["volume"]) * 1e3
@@ -124,6 +155,11 @@ def draw(vtu, t, cfg, field, dots, title, png, dpi, first):
                      label="pressure −tr σ/3 [MPa]" if field == "pressure" else field)
     if dots:
         ax.plot(xy[:, 0], xy[:, 1], "k.", ms=0.8)
+    if forces is not None and len(forces[1]):
+        segs, fn = forces
+        widths = np.clip(1.5 * fn / fn.mean(), 0.2, 8.0)
+        ax.add_collection(LineCollection(segs, linewidths=widths, colors="firebrick", alpha=0.85,
+                                         capstyle="round", zorder=3))
     lo, hi = xy.min(axis=0) - 2 * half.max(), xy.max(axis=0) + 2 * half.max()
     for p, d in wall_segments(cfg, t):
         p = p * 1e3
@@ -139,7 +175,8 @@ def draw(vtu, t, cfg, field, dots, title, png, dpi, first):
     ax.set_ylabel("y [mm]")
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(png, dpi=dpi)
+    for path in paths:
+        fig.savefig(path, dpi=dpi)
     plt.close(fig)
 
 
@@ -153,6 +190,10 @@ def main():
     ap.add_argument("--dpi", type=int, default=150)
     ap.add_argument("--squares", action="store_true",
                     help="plain squares of side sqrt(V) instead of the deformed domains")
+    ap.add_argument("--forces", action="store_true",
+                    help="the contact-force network over the grains (needs [output] grains = true)")
+    ap.add_argument("--format", nargs="+", default=["png"], choices=["png", "pdf", "svg"],
+                    help="file formats (pdf and svg are vector)")
     args = ap.parse_args()
     cfg, cols, series = read_run(args.folder)
     out = args.output or os.path.join(args.folder, "snapshots")
@@ -167,11 +208,18 @@ def main():
         t, vtu = series[k]
         at = int(np.argmin(np.abs(cols["time"] - t)))  # CSV row of the snapshot
         phi, eps = cols["phi"][at], cols["eps"][at]
-        png = os.path.join(out, f"snapshot_phi{target:.3f}_{args.field}.png")
+        forces = None
+        if args.forces:
+            forces = force_network(args.folder, cfg.get("simulation", {}).get("name", "mpmcd"), vtu)
+            if forces is None:
+                fail(f"--forces: no grains/forces CSV for {os.path.basename(vtu)} (run with "
+                     "[output] grains = true)")
+        stem = f"snapshot_phi{target:.3f}_{args.field}" + ("_forces" if args.forces else "")
+        paths = [os.path.join(out, f"{stem}.{ext}") for ext in args.format]
         title = f"{lam_text}Φ = {phi:.3f}, ε = {eps:.3f}, t = {t:.4g} s"
-        draw(vtu, t, cfg, args.field, args.dots, title, png, args.dpi, first)
+        draw(vtu, t, cfg, args.field, args.dots, title, paths, args.dpi, first, forces)
         print(f"Φ = {target:g}: {os.path.basename(vtu)} (t = {t:.6g} s, Φ = {phi:.4f}, "
-              f"ε = {eps:.4f}) -> {png}")
+              f"ε = {eps:.4f}) -> {', '.join(paths)}")
 
 
 if __name__ == "__main__":
