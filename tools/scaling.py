@@ -53,6 +53,17 @@ a = ap.parse_args()
 os.makedirs(a.out, exist_ok=True)
 
 
+def speedup_axes():
+    """A figure with the ideal line, for speedup against processes to 60 (both scaling figures);
+    raises ImportError without matplotlib."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    ax.plot([1, 60], [1, 60], "k-", lw=1, label="ideal")
+    return fig, ax
+
+
 def finish_speedup_plot(fig, ax, xlabel, title, name):
     """Axes to 60 processes, labels, legend; saves <out>/<name> (both scaling figures)."""
     ax.set_xlabel(xlabel)
@@ -110,11 +121,7 @@ def dense_mode():
     print(open(os.path.join(a.out, "dense_speedup.csv")).read())
     print(open(os.path.join(a.out, "dense_amdahl.csv")).read())
     try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(5.5, 4.2))
-        ax.plot([1, 60], [1, 60], "k-", lw=1, label="ideal")
+        fig, ax = speedup_axes()
         xs = list(range(1, 61))
         for grid, mark in zip(sorted(amdahl), "os^v"):
             pts = sorted((t, rows[(grid, 1)][0] / ms) for (g, t), (ms, _) in rows.items()
@@ -283,11 +290,7 @@ print(open(os.path.join(a.out, "bytes.csv")).read())
 print(open(os.path.join(a.out, "serial_fraction.csv")).read())
 print(open(os.path.join(a.out, "amdahl.csv")).read())
 try:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
-    ax.plot([1, 60], [1, 60], "k-", lw=1, label="ideal")
+    fig, ax = speedup_axes()
     for sch, mark in (("partition", "o"), ("master", "s")):
         sel = [r for r in rows
                if r["threads"] == "1" and (r["scheme"] == sch or r["ranks"] == "1")]
