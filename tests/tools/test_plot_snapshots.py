@@ -9,8 +9,8 @@ Usage: test_plot_snapshots.py [workdir]
 - a concavity wider than a domain stays open (an annulus keeps its hole);
 - neighbouring grains never share a colour: seven touching disks (a hexagon around one), pairs
   only in the contact list, and a wheel graph with a palette too small for it;
-- the command end to end on a synthetic run folder (PNG, PDF, SVG, --forces), and bad input:
-  exit 2 with a message naming the file.
+- the command end to end on a synthetic run folder (PNG, PDF, SVG, --forces; each field), and
+  bad input: exit 2 with a message naming the file.
 """
 import os
 import subprocess
@@ -209,7 +209,7 @@ class CommandLine(unittest.TestCase):
         folder = os.path.join(WORK, "run_ok")
         run_folder(folder)
         out = os.path.join(folder, "pics")
-        for field in ("grain", "pressure"):
+        for field in ("grain", "pressure", "point_pressure"):
             res = plot(folder, "--phi", "0.785", "--field", field, "--forces", "-o", out,
                        "--format", "png", "pdf", "svg")
             print(res.stdout.strip())
@@ -222,6 +222,7 @@ class CommandLine(unittest.TestCase):
                 svg = f.read()
             self.assertIn("<svg", svg)
             self.assertNotIn("Figure", svg)
+            self.assertLess(len(svg), 2_000_000)  # shading inside grains is an embedded image
             self.assertTrue(os.path.getsize(stem + ".png") > 1000)
 
     def check_refused(self, folder, *expected, args=()):
