@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Reads the point-cloud .vtu files written by mpmcd (raw appended binary) into numpy arrays.
 
-Usage as a module: `points, arrays = read_vtu(path)`; as a script: `vtu_points.py file.vtu` prints
+Usage as a module: `points, arrays = read_vtu(path)` (and `write_vtu(path, points, arrays)`, the
+same layout, for tests); as a script: `vtu_points.py file.vtu` prints
 the array names and ranges.
 """
 import re
@@ -32,6 +33,34 @@ def read_vtu(path):
         else:
             points = data
     return points, arrays
+
+
+def write_vtu(path, points, arrays):
+    """Writes points (n, 3) and {name: array} (float64, or int32 for integer arrays; (n,) or
+    (n, components)) as a vertex cloud in mpmcd's layout (raw appended data)."""
+    n = len(points)
+    head, blob = [], b""
+
+    def block(a):
+        return np.uint64(a.nbytes).tobytes() + a.tobytes()
+
+    for name, a in arrays.items():
+        a = np.ascontiguousarray(a, np.int32 if np.issubdtype(a.dtype, np.integer) else np.float64)
+        kind = "Int32" if a.dtype == np.int32 else "Float64"
+        comps = 1 if a.ndim == 1 else a.shape[1]
+        head.append(f'<DataArray type="{kind}" Name="{name}" NumberOfComponents="{comps}" '
+                    f'format="appended" offset="{len(blob)}"/>')
+        blob += block(a)
+    pos = ('<DataArray type="Float64" NumberOfComponents="3" format="appended" '
+           f'offset="{len(blob)}"/>')
+    blob += block(np.ascontiguousarray(points, np.float64))
+    text = ('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" '
+            'byte_order="LittleEndian" header_type="UInt64">\n<UnstructuredGrid>\n'
+            f'<Piece NumberOfPoints="{n}" NumberOfCells="0">\n<PointData>\n' + "\n".join(head)
+            + f"\n</PointData>\n<Points>\n{pos}\n</Points>\n</Piece>\n</UnstructuredGrid>\n"
+            '<AppendedData encoding="raw">\n_')
+    with open(path, "wb") as f:
+        f.write(text.encode() + blob + b"\n</AppendedData>\n</VTKFile>\n")
 
 
 if __name__ == "__main__":

@@ -28,6 +28,10 @@ void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {
   auto& mass = vtu.add_array("mass", 1);
   auto& vol = vtu.add_array("volume", 1);
   auto& grain = vtu.add_int_array("grain");
+  // The point's current domain x + e1 s1 + e2 s2, s in [-1, 1]^2: e1, e2 the columns of F D (the
+  // CPDI domain, also for linear shapes; the one analysis::domain_coverage rasterises).
+  auto& e1 = vtu.add_array("domain_e1", 3);
+  auto& e2 = vtu.add_array("domain_e2", 3);
   for (std::size_t i = 0; i < p.size(); ++i) {
     vtu.set_position(i, p.x[i][0], p.x[i][1]);
     vel[3 * i] = p.v[i][0];
@@ -40,6 +44,11 @@ void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {
     mass[i] = p.mass[i];
     vol[i] = p.volume[i];
     grain[i] = p.grain[i];
+    const Mat<2> e = p.F[i] * p.domain[i];
+    for (int k = 0; k < 2; ++k) {
+      e1[3 * i + k] = e(k, 0);
+      e2[3 * i + k] = e(k, 1);
+    }
   }
   vtu.write(path);
 }
