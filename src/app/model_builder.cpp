@@ -287,6 +287,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
   c.impulse_tolerance = cfg.contact.impulse_tolerance;
   c.wall_range = cfg.contact.wall_range;
   c.wall_points = cfg.contact.wall_contact == "points";
+  c.grain_faces = cfg.contact.grain_contact == "faces";
   // Delassus operator: the lumped 1/m_I is accurate when inertia dominates a step (theta c_p dt/h
   // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered
   // contact-Newton loop converging in a few iterations.

@@ -354,6 +354,13 @@ Schema build_schema() {
                        "the wall; one MPI rank only for now; docs/accuracy.md)")
            .one_of({"nodes", "points"})
            .default_of_member(),
+       KeySpec::string("grain_contact", &ContactSection::grain_contact,
+                       "where grains meet: \"nodes\" (the two fields' velocities at each shared "
+                       "grid node) or \"faces\" (the boundary faces of one grain's points against "
+                       "the other grain's velocity there: contact on the material surface; one MPI "
+                       "rank only for now; docs/contact.md)")
+           .one_of({"nodes", "faces"})
+           .default_of_member(),
        KeySpec::string("delassus", &ContactSection::delassus,
                        "contact compliance: \"grain\" (each grain's exact linearised response "
                        "from its factorised Newton matrix; direct solvers), \"lumped\" (1/m_I), "

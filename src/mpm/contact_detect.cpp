@@ -2,6 +2,7 @@
 // faces of the points facing a wall) and the grain-grain and grain-wall contacts with their
 // normals, gaps and warm-start impulses, then the compliance groups.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -35,105 +36,6 @@ std::int32_t ImplicitSolver<Dim>::slot_of(std::int32_t g, std::int32_t a) {
 }
 
 template <int Dim>
-std::int32_t ImplicitSolver<Dim>::face_slot(std::int32_t g, const std::vector<std::int64_t>& pts,
-                                            const Vec<Dim>& n, Vec<Dim>& x_face) {
-  // The point's domain x_p + D s, s in [-1, 1]^Dim, D = F D0; the face toward the wall (normal
-  // n into the domain) is the face s_k = -sign(m_k . n) whose normal m_k = D^-T e_k is the most
-  // nearly parallel to n: all 2^(Dim-1) corners of that face, whatever the domain's small shear
-  // or rotation (choosing the corners that minimise s . D^T n instead switches from a face to a
-  // single corner, and so changes the constraint's nodes and weights, as soon as round-off
-  // shears the domain: docs/accuracy.md, "Uniaxial stress"). Its velocity is the mean of the
-  // corners' velocities interpolated with the linear hat (the same corner kinematics as CPDI):
-  // weights w_I = mean over the face corners of N_I(x_c).
-  const GrainWork& w = *work_[g];
-  const double h = grid_.cell_size();
-  std::vector<std::int32_t> nodes;
-  std::vector<double> weights;
-  int count = 0;
-  double total = 0;
-  x_face.setZero();
-  for (const std::int64_t p : pts) {
-    const Mat<Dim> D = points_.F[p] * points_.domain[p];
-    const Mat<Dim> m = D.inverse().transpose();  // columns: face normals m_k (unnormalised)
-    int axis = 0;
-    double best = -1;
-    for (int d = 0; d < Dim; ++d) {
-      const double align = std::abs(m.col(d).dot(n)) / m.col(d).norm();
-      if (align > best) {
-        best = align;
-        axis = d;
-      }
-    }
-    Vec<Dim> s = Vec<Dim>::Zero();
-    s[axis] = m.col(axis).dot(n) > 0 ? -1.0 : 1.0;
-    const int corners = 1 << (Dim - 1);
-    x_face += (points_.x[p] + D * s) / static_cast<double>(pts.size());
-    for (int c = 0; c < corners; ++c) {
-      Vec<Dim> sc = s;
-      for (int d = 0, bit = 0; d < Dim; ++d)
-        if (s[d] == 0.0) sc[d] = (c >> bit++) & 1 ? 1.0 : -1.0;
-      const Vec<Dim> xi = (points_.x[p] + D * sc - grid_.origin()) / h;
-      IVec<Dim> cell;
-      Vec<Dim> t;
-      for (int d = 0; d < Dim; ++d) {
-        cell[d] = static_cast<std::int64_t>(std::floor(xi[d]));
-        t[d] = xi[d] - static_cast<double>(cell[d]);
-      }
-      for (int b = 0; b < (1 << Dim); ++b) {
-        double wt = 1.0 / corners;
-        IVec<Dim> node = cell - w.box_lo;
-        for (int d = 0; d < Dim; ++d) {
-          const int up = (b >> d) & 1;
-          wt *= up ? t[d] : 1.0 - t[d];
-          node[d] += up;
-        }
-        if (wt == 0.0) continue;
-        if ((node.array() < 0).any() || (node.array() >= w.box_n.array()).any()) continue;
-        std::int64_t idx = 0, mul = 1;
-        for (int d = 0; d < Dim; ++d) {
-          idx += node[d] * mul;
-          mul *= w.box_n[d];
-        }
-        const std::int32_t a = w.box_to_active[idx];
-        if (a < 0) continue;  // no mass there: the face's weight goes to the other nodes
-        int k = 0;
-        while (k < count && nodes[k] != a) ++k;
-        if (k == count) {
-          nodes.push_back(a);
-          weights.push_back(0.0);
-          ++count;
-        }
-        weights[k] += wt;
-        total += wt;
-      }
-    }
-  }
-  if (count == 0 || !(total > 0)) return -1;
-  const auto sidx = static_cast<std::int32_t>(problem_.slots.size());
-  double inv_mass = 0;
-  std::int32_t primary = nodes[0];
-  double wmax = 0;
-  for (int k = 0; k < count; ++k) {
-    weights[k] /= total;
-    slot_node_.push_back(nodes[k]);
-    slot_weight_.push_back(weights[k]);
-    inv_mass += weights[k] * weights[k] / w.m[nodes[k]];
-    if (weights[k] > wmax) {
-      wmax = weights[k];
-      primary = nodes[k];
-    }
-  }
-  slot_start_.push_back(static_cast<std::int32_t>(slot_node_.size()));
-  slot_is_face_.push_back(1);
-  slot_key_.push_back(-1);
-  problem_.slots.push_back({1.0 / inv_mass, Vec<Dim>::Zero(), g, w.node_global[primary]});
-  slot_ref_.emplace_back(g, primary);
-  slot_next_.push_back(-1);  // not linked to its node: slot_of never returns a face slot
-  problem_.slots.back().v_free = slot_velocity(static_cast<std::size_t>(sidx));
-  return sidx;
-}
-
-template <int Dim>
 void ImplicitSolver<Dim>::detect_contacts(double dt) {
   const ContactSettings<Dim>& cs = settings_.contact;
   const double h = grid_.cell_size();
@@ -156,14 +58,8 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
     slot_head_.assign(nn, -1);
   }
   ++stamp_;
-  const auto warm = [&](std::int64_t node, std::int32_t a, std::int32_t b) -> Vec<Dim> {
-    const WarmImpulse<Dim> key{node, a, b, Vec<Dim>::Zero()};
-    auto it = std::lower_bound(previous_.begin(), previous_.end(), key,
-                               [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
-                                 return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
-                               });
-    if (it != previous_.end() && it->node == node && it->a == a && it->b == b) return it->impulse;
-    return Vec<Dim>::Zero();
+  const auto warm = [&](std::int64_t node, std::int32_t a, std::int32_t b) {
+    return warm_impulse(node, a, b);
   };
   // Extent of point p's domain (reference half-edges r_i, the columns of `domain`, mapped by F)
   // along the unit vector n: sum_i |n . F r_i| [m] (lp |F^T n|_1 for a lattice square).
@@ -217,7 +113,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   // whose distance minus both reaches is not below the gap found so far cannot lower it and is
   // skipped (the same gap, far fewer extents: the point pairs of a CPDI node are most of the
   // detection's time otherwise).
-  if (cs.criterion == GapCriterion::kGap) {
+  if (cs.criterion == GapCriterion::kGap || cs.grain_faces) {
     point_reach_.resize(points_.x.size());
     const auto nl = static_cast<std::int64_t>(local_.size());
 #pragma omp parallel for schedule(dynamic, 4) if (nl > 1)
@@ -232,9 +128,23 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   }
   // Work count (Comm::count_work): node fields, pairs and point pairs of the gaps examined here.
   double items = static_cast<double>(entries.size());
+  if (cs.grain_faces) {
+    // Contacts at the material surface (grain_face_contacts): the pairs of fields at each shared
+    // node tell which grains may touch and where.
+    std::vector<std::array<std::int32_t, 4>> links;
+    for (const std::int64_t n : shared)
+      for (std::int32_t e1 = node_head_[n]; e1 >= 0; e1 = entries[e1].next)
+        for (std::int32_t e2 = entries[e1].next; e2 >= 0; e2 = entries[e2].next) {
+          Entry A = entries[e1], B = entries[e2];
+          if (A.g > B.g) std::swap(A, B);
+          links.push_back({A.g, B.g, A.a, B.a});
+        }
+    items += static_cast<double>(links.size()) + grain_face_contacts(links);
+  }
   ThreadedRegion threaded(&timers_, nshared > 256);
 #pragma omp parallel for schedule(dynamic, 32) if (nshared > 256) reduction(+ : items)
   for (std::int64_t i = 0; i < nshared; ++i) {
+    if (cs.grain_faces) continue;
     const std::int64_t n = shared[i];
     if (node_rank(n) != me) continue;
     for (std::int32_t e1 = node_head_[n]; e1 >= 0; e1 = entries[e1].next)
@@ -472,8 +382,6 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
 // The members defined here (the class is instantiated in solver.cpp).
 #define MPMCD_INSTANTIATE(D)                                                    \
   template std::int32_t ImplicitSolver<D>::slot_of(std::int32_t, std::int32_t); \
-  template std::int32_t ImplicitSolver<D>::face_slot(                           \
-      std::int32_t, const std::vector<std::int64_t>&, const Vec<D>&, Vec<D>&);  \
   template void ImplicitSolver<D>::detect_contacts(double);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)

@@ -124,6 +124,7 @@ struct ContactSection {
   double impulse_tolerance = 1e-6;  ///< relative impulse change between Newton iterations [-]
   double wall_range = 1.0;          ///< grain nodes within this many cells of a wall take part [-]
   std::string wall_contact = "nodes";     ///< where walls act: "nodes" or "points" (point faces)
+  std::string grain_contact = "nodes";    ///< where grains meet: "nodes" or "faces" (point faces)
   std::string delassus = "auto";          ///< "grain" (exact grain compliance), "lumped" or "auto"
   std::vector<ContactPairSection> pairs;  ///< per material-pair friction
 };

@@ -148,6 +148,19 @@ class ImplicitSolver {
   // mean face centre to x_face [m]; -1 if the faces touch no active node.
   std::int32_t face_slot(std::int32_t g, const std::vector<std::int64_t>& pts, const Vec<Dim>& n,
                          Vec<Dim>& x_face);
+  // The warm-start impulse of contact (key, a, b) kept from the last step (zero if none) [N s].
+  Vec<Dim> warm_impulse(std::int64_t key, std::int32_t a, std::int32_t b) const;
+  // Linear hat weights of the positions `corners` [m] at grain g's active nodes, `weight` each,
+  // normalised to a sum of 1 (nodes, weights); false if no active node carries any.
+  bool corner_weights(std::int32_t g, const std::vector<Vec<Dim>>& corners, double weight,
+                      std::vector<std::int32_t>& nodes, std::vector<double>& weights) const;
+  // A slot of grain g carrying the weighted mean of the velocities of its active `nodes`.
+  std::int32_t weighted_slot(std::int32_t g, const std::vector<std::int32_t>& nodes,
+                             const std::vector<double>& weights);
+  // Grain-grain contacts at the boundary faces of the points (ContactSettings::grain_faces) for
+  // the pairs sharing nodes, links = (grain A < grain B, A's active node, B's active node);
+  // appends them to the problem and returns the items examined (work count) [-].
+  double grain_face_contacts(std::vector<std::array<std::int32_t, 4>>& links);
   // Velocity of slot s from its grain's current nodal iterate: sum_k w_k v_{a_k} [m/s].
   Vec<Dim> slot_velocity(std::size_t s) const;
   // Nodal impulses of every grain from the slots' impulses slot_P_: P_a = sum_s w_sa P_s.

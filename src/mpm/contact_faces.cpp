@@ -1,0 +1,323 @@
+// Contacts at the faces of the points' domains (docs/accuracy.md): the slots that carry a weighted
+// mean of a grain's nodal velocities (a face, or a set of positions), the faces facing a wall, and
+// the grain-grain contacts between a grain's boundary faces and the other grain's material.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <tuple>
+#include <vector>
+
+#include "solver_detail.hpp"
+
+namespace mpmcd::mpm {
+
+template <int Dim>
+Vec<Dim> ImplicitSolver<Dim>::warm_impulse(std::int64_t key, std::int32_t a, std::int32_t b) const {
+  const WarmImpulse<Dim> k{key, a, b, Vec<Dim>::Zero()};
+  auto it = std::lower_bound(previous_.begin(), previous_.end(), k,
+                             [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
+                               return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
+                             });
+  if (it != previous_.end() && it->node == key && it->a == a && it->b == b) return it->impulse;
+  return Vec<Dim>::Zero();
+}
+
+template <int Dim>
+bool ImplicitSolver<Dim>::corner_weights(std::int32_t g, const std::vector<Vec<Dim>>& corners,
+                                         double weight, std::vector<std::int32_t>& nodes,
+                                         std::vector<double>& weights) const {
+  // The linear hat weights of each position at the grain's active nodes, `weight` each
+  // position, normalised to a sum of 1 (a node without mass gives its share to the others).
+  const GrainWork& w = *work_[g];
+  const double h = grid_.cell_size();
+  nodes.clear();
+  weights.clear();
+  double total = 0;
+  for (const Vec<Dim>& x : corners) {
+    const Vec<Dim> xi = (x - grid_.origin()) / h;
+    IVec<Dim> cell;
+    Vec<Dim> t;
+    for (int d = 0; d < Dim; ++d) {
+      cell[d] = static_cast<std::int64_t>(std::floor(xi[d]));
+      t[d] = xi[d] - static_cast<double>(cell[d]);
+    }
+    for (int b = 0; b < (1 << Dim); ++b) {
+      double wt = weight;
+      IVec<Dim> node = cell - w.box_lo;
+      for (int d = 0; d < Dim; ++d) {
+        const int up = (b >> d) & 1;
+        wt *= up ? t[d] : 1.0 - t[d];
+        node[d] += up;
+      }
+      if (wt == 0.0) continue;
+      if ((node.array() < 0).any() || (node.array() >= w.box_n.array()).any()) continue;
+      std::int64_t idx = 0, mul = 1;
+      for (int d = 0; d < Dim; ++d) {
+        idx += node[d] * mul;
+        mul *= w.box_n[d];
+      }
+      const std::int32_t a = w.box_to_active[idx];
+      if (a < 0) continue;  // no mass there: the position's weight goes to the other nodes
+      std::size_t k = 0;
+      while (k < nodes.size() && nodes[k] != a) ++k;
+      if (k == nodes.size()) {
+        nodes.push_back(a);
+        weights.push_back(0.0);
+      }
+      weights[k] += wt;
+      total += wt;
+    }
+  }
+  if (nodes.empty() || !(total > 0)) return false;
+  for (double& wk : weights) wk /= total;
+  return true;
+}
+
+template <int Dim>
+std::int32_t ImplicitSolver<Dim>::weighted_slot(std::int32_t g,
+                                                const std::vector<std::int32_t>& nodes,
+                                                const std::vector<double>& weights) {
+  // Effective mass 1 / sum w_k^2 / m_k: the lumped response of the mean velocity to an impulse.
+  const GrainWork& w = *work_[g];
+  const auto sidx = static_cast<std::int32_t>(problem_.slots.size());
+  double inv_mass = 0;
+  std::int32_t primary = nodes[0];
+  double wmax = 0;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    slot_node_.push_back(nodes[k]);
+    slot_weight_.push_back(weights[k]);
+    inv_mass += weights[k] * weights[k] / w.m[nodes[k]];
+    if (weights[k] > wmax) {
+      wmax = weights[k];
+      primary = nodes[k];
+    }
+  }
+  slot_start_.push_back(static_cast<std::int32_t>(slot_node_.size()));
+  slot_is_face_.push_back(1);
+  slot_key_.push_back(-1);
+  problem_.slots.push_back({1.0 / inv_mass, Vec<Dim>::Zero(), g, w.node_global[primary]});
+  slot_ref_.emplace_back(g, primary);
+  slot_next_.push_back(-1);  // not linked to its node: slot_of never returns a face slot
+  problem_.slots.back().v_free = slot_velocity(static_cast<std::size_t>(sidx));
+  return sidx;
+}
+
+template <int Dim>
+std::int32_t ImplicitSolver<Dim>::face_slot(std::int32_t g, const std::vector<std::int64_t>& pts,
+                                            const Vec<Dim>& n, Vec<Dim>& x_face) {
+  // The point's domain x_p + D s, s in [-1, 1]^Dim, D = F D0; the face toward the wall (normal
+  // n into the domain) is the face s_k = -sign(m_k . n) whose normal m_k = D^-T e_k is the most
+  // nearly parallel to n: all 2^(Dim-1) corners of that face, whatever the domain's small shear
+  // or rotation (choosing the corners that minimise s . D^T n instead switches from a face to a
+  // single corner, and so changes the constraint's nodes and weights, as soon as round-off
+  // shears the domain: docs/accuracy.md, "Uniaxial stress"). Its velocity is the mean of the
+  // corners' velocities interpolated with the linear hat (the same corner kinematics as CPDI):
+  // weights w_I = mean over the face corners of N_I(x_c).
+  constexpr int corners = 1 << (Dim - 1);
+  std::vector<Vec<Dim>> xs;
+  xs.reserve(pts.size() * corners);
+  x_face.setZero();
+  for (const std::int64_t p : pts) {
+    const Mat<Dim> D = points_.F[p] * points_.domain[p];
+    const Mat<Dim> m = D.inverse().transpose();  // columns: face normals m_k (unnormalised)
+    int axis = 0;
+    double best = -1;
+    for (int d = 0; d < Dim; ++d) {
+      const double align = std::abs(m.col(d).dot(n)) / m.col(d).norm();
+      if (align > best) {
+        best = align;
+        axis = d;
+      }
+    }
+    Vec<Dim> s = Vec<Dim>::Zero();
+    s[axis] = m.col(axis).dot(n) > 0 ? -1.0 : 1.0;
+    x_face += (points_.x[p] + D * s) / static_cast<double>(pts.size());
+    for (int c = 0; c < corners; ++c) {
+      Vec<Dim> sc = s;
+      for (int d = 0, bit = 0; d < Dim; ++d)
+        if (s[d] == 0.0) sc[d] = (c >> bit++) & 1 ? 1.0 : -1.0;
+      xs.push_back(points_.x[p] + D * sc);
+    }
+  }
+  std::vector<std::int32_t> nodes;
+  std::vector<double> weights;
+  if (!corner_weights(g, xs, 1.0 / corners, nodes, weights)) return -1;
+  return weighted_slot(g, nodes, weights);
+}
+
+template <int Dim>
+double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int32_t, 4>>& links) {
+  // Grain-grain contacts at the material surface (ContactSettings::grain_faces, docs/contact.md):
+  // for each pair of grains A < B whose fields share nodes, every boundary face of either
+  // grain's points there (no other domain of its grain just beyond it) whose outward normal
+  // meets a domain of the other grain within wall_range cells makes one contact: the mean
+  // velocity of the face's corners in its grain's field against the other grain's velocity at
+  // the same corners, along the face's normal, with the distance to the other grain's domains
+  // along that normal as the gap (Signorini on the relative velocity of the material surface,
+  // u_n + g/dt >= 0, method.md §4). Both grains' faces take part (two passes): with the faces of
+  // one grain only, the other grain's corners enter it between them (mirror test: 0.72-0.80 of
+  // the wall's force at d/4 instead of 0.94-0.99). The constraints are then redundant where the
+  // two surfaces meet, which Gauss-Seidel tolerates at the price of more sweeps (docs/contact.md).
+  const ContactSettings<Dim>& cs = settings_.contact;
+  const double h = grid_.cell_size(), range = cs.wall_range * h;
+  constexpr int corners = 1 << (Dim - 1);
+  std::sort(links.begin(), links.end());
+  const IVec<Dim>& ncell = grid_.cells();
+  const auto cell_of = [&](const Vec<Dim>& x) {
+    IVec<Dim> c;
+    for (int d = 0; d < Dim; ++d)
+      c[d] = static_cast<std::int64_t>(std::floor((x[d] - grid_.origin()[d]) / h));
+    return c;
+  };
+  const auto key_of = [&](const IVec<Dim>& c) -> std::int64_t {  // -1 outside the grid
+    std::int64_t k = 0, mul = 1;
+    for (int d = 0; d < Dim; ++d) {
+      if (c[d] < 0 || c[d] >= ncell[d]) return -1;
+      k += c[d] * mul;
+      mul *= ncell[d];
+    }
+    return k;
+  };
+  // Each grain's points by the cell of their centre (sorted (cell, point)), made when needed.
+  std::vector<std::vector<std::pair<std::int64_t, std::int64_t>>> by_cell(grains_.size());
+  const auto index =
+      [&](std::int32_t g) -> const std::vector<std::pair<std::int64_t, std::int64_t>>& {
+    auto& v = by_cell[static_cast<std::size_t>(g)];
+    if (v.empty()) {
+      for (std::int64_t p = grains_[g].begin; p < grains_[g].end; ++p)
+        v.emplace_back(key_of(cell_of(points_.x[p])), p);
+      std::sort(v.begin(), v.end());
+    }
+    return v;
+  };
+  // Calls f(q) for the points q of grain g whose centre is within r cells (per axis) of x's cell.
+  const auto near = [&](std::int32_t g, const Vec<Dim>& x, int r, auto&& f) {
+    const auto& v = index(g);
+    const IVec<Dim> c0 = cell_of(x);
+    IVec<Dim> off = IVec<Dim>::Constant(-r);
+    while (true) {
+      const std::int64_t k = key_of(c0 + off);
+      if (k >= 0) {
+        auto it = std::lower_bound(v.begin(), v.end(), std::make_pair(k, std::int64_t{-1}));
+        for (; it != v.end() && it->first == k; ++it) f(it->second);
+      }
+      int d = 0;
+      while (d < Dim && off[d] == r) off[d++] = -r;
+      if (d == Dim) break;
+      ++off[d];
+    }
+  };
+  // Entry distance t of the ray x + t nu into point q's domain x_q + D s, |s_i| <= 1 (slabs);
+  // +infinity when the ray misses it or the domain lies behind x [m].
+  const auto entry = [&](std::int64_t q, const Vec<Dim>& x, const Vec<Dim>& nu) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    const Mat<Dim> Dq = (points_.F[q] * points_.domain[q]).inverse();
+    const Vec<Dim> s0 = Dq * (x - points_.x[q]), ds = Dq * nu;
+    double t_in = -inf, t_out = inf;
+    for (int d = 0; d < Dim; ++d) {
+      if (std::abs(ds[d]) < 1e-300) {
+        if (std::abs(s0[d]) > 1.0) return inf;
+        continue;
+      }
+      double t1 = (-1.0 - s0[d]) / ds[d], t2 = (1.0 - s0[d]) / ds[d];
+      if (t1 > t2) std::swap(t1, t2);
+      t_in = std::max(t_in, t1);
+      t_out = std::min(t_out, t2);
+    }
+    return t_in <= t_out && t_out > 0 ? t_in : inf;
+  };
+  double items = 0;
+  std::vector<std::int64_t> zone;
+  std::vector<Vec<Dim>> xs(corners);
+  std::vector<std::int32_t> nodes_x, nodes_y;
+  std::vector<double> weights_x, weights_y;
+  // The contacts of grain X's boundary faces at the pair's shared nodes (links[i][col], i in
+  // [i0, i1), are X's active nodes there) against grain Y.
+  const auto faces_of = [&](std::int32_t X, std::int32_t Y, int col, std::size_t i0,
+                            std::size_t i1) {
+    const GrainWork& wx = *work_[X];
+    zone.clear();
+    for (std::size_t i = i0; i < i1; ++i)
+      for (std::int32_t k = wx.node_pts_start[links[i][col]];
+           k < wx.node_pts_start[links[i][col] + 1]; ++k)
+        zone.push_back(grains_[X].begin + wx.node_pts[k]);
+    std::sort(zone.begin(), zone.end());
+    zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+    for (const std::int64_t p : zone) {
+      const Mat<Dim> D = points_.F[p] * points_.domain[p];
+      const Mat<Dim> Dinv = D.inverse();
+      for (int k = 0; k < Dim; ++k)
+        for (const int side : {0, 1}) {
+          // Face s_k = sign: outward normal sign D^-T e_k, at 1/|D^-T e_k| from the centre.
+          const double sign = side ? 1.0 : -1.0;
+          const Vec<Dim> m = Dinv.row(k).transpose();
+          const double len = m.norm();
+          const Vec<Dim> nu = sign * m / len;
+          const Vec<Dim> xf = points_.x[p] + sign * D.col(k);
+          items += 1;
+          // Interior face: another domain of X holds the point half a domain beyond it.
+          const Vec<Dim> xt = xf + 0.5 / len * nu;
+          bool interior = false;
+          near(X, xt, 1, [&](std::int64_t q) {
+            if (interior || q == p) return;
+            const Mat<Dim> Dq = points_.F[q] * points_.domain[q];
+            interior = (Dq.inverse() * (xt - points_.x[q])).cwiseAbs().maxCoeff() <= 1.0;
+          });
+          if (interior) continue;
+          double gap = std::numeric_limits<double>::infinity();
+          near(Y, xf, 2, [&](std::int64_t q) {
+            if ((points_.x[q] - xf).norm() <= point_reach_[q] + range)
+              gap = std::min(gap, entry(q, xf, nu));
+          });
+          if (!(gap <= range)) continue;
+          for (int c = 0; c < corners; ++c) {
+            Vec<Dim> sc = Vec<Dim>::Zero();
+            sc[k] = sign;
+            for (int d = 0, bit = 0; d < Dim; ++d)
+              if (d != k) sc[d] = (c >> bit++) & 1 ? 1.0 : -1.0;
+            xs[static_cast<std::size_t>(c)] = points_.x[p] + D * sc;
+          }
+          if (!corner_weights(X, xs, 1.0, nodes_x, weights_x) ||
+              !corner_weights(Y, xs, 1.0, nodes_y, weights_y))
+            continue;
+          contact::Contact<Dim> c;
+          c.a = weighted_slot(X, nodes_x, weights_x);
+          c.b = weighted_slot(Y, nodes_y, weights_y);
+          // Warm-start key: -1 - the face's number (point, axis, side), stable from step to step.
+          slot_key_[c.b] = -1 - (p * 2 * Dim + 2 * k + side);
+          c.normal = nu;
+          c.gap = std::max(0.0, gap);
+          c.friction = cs.friction[grains_[X].material * cs.materials + grains_[Y].material];
+          c.impulse = warm_impulse(slot_key_[c.b], X, Y);
+          problem_.contacts.push_back(c);
+        }
+    }
+  };
+  for (std::size_t i0 = 0; i0 < links.size();) {
+    const std::int32_t A = links[i0][0], B = links[i0][1];
+    std::size_t i1 = i0;
+    while (i1 < links.size() && links[i1][0] == A && links[i1][1] == B) ++i1;
+    faces_of(A, B, 2, i0, i1);
+    faces_of(B, A, 3, i0, i1);
+    i0 = i1;
+  }
+  return items;
+}
+
+// The members defined here (the class is instantiated in solver.cpp).
+#define MPMCD_INSTANTIATE(D)                                                                       \
+  template Vec<D> ImplicitSolver<D>::warm_impulse(std::int64_t, std::int32_t, std::int32_t) const; \
+  template bool ImplicitSolver<D>::corner_weights(std::int32_t, const std::vector<Vec<D>>&,        \
+                                                  double, std::vector<std::int32_t>&,              \
+                                                  std::vector<double>&) const;                     \
+  template std::int32_t ImplicitSolver<D>::weighted_slot(                                          \
+      std::int32_t, const std::vector<std::int32_t>&, const std::vector<double>&);                 \
+  template std::int32_t ImplicitSolver<D>::face_slot(                                              \
+      std::int32_t, const std::vector<std::int64_t>&, const Vec<D>&, Vec<D>&);                     \
+  template double ImplicitSolver<D>::grain_face_contacts(std::vector<std::array<std::int32_t, 4>>&);
+MPMCD_INSTANTIATE(2)
+MPMCD_INSTANTIATE(3)
+#undef MPMCD_INSTANTIATE
+
+}  // namespace mpmcd::mpm
