@@ -64,9 +64,9 @@ struct ContactSettings {
   /// not a node beyond it, at the wall. Points within wall_range cells of a wall are candidates.
   bool wall_points = false;
   /// Where grains meet (docs/contact.md): false = at shared grid nodes (the two fields'
-  /// velocities at a node, along the mass-gradient normal), true = at the material surface: the
-  /// boundary faces of the lower grain's points against the other grain's velocity at the same
-  /// places, along the faces' normals (one contact per grid cell of faces). One rank only.
+  /// velocities at a node, along the mass-gradient normal), true = at the material surface: each
+  /// boundary face of either grain's points near the other grain against the other grain's
+  /// velocity at the face's corners, along the face's normal. One MPI rank only for now.
   bool grain_faces = false;
   contact::GsSettings gs;           ///< Gauss-Seidel tolerance and sweep limit
   double impulse_tolerance = 1e-6;  ///< relative change of impulses between Newton iterations [-]
