@@ -380,12 +380,14 @@ void check_biaxial(std::initializer_list<std::tuple<double, double, int>> cases,
 // The right wall at V2 = V/2 (a = 0.75 at s = 0.5): its face crosses the grid lines x = 1.4 and
 // 1.3 mm at s = 0.8 and 0.6, the top face y = 1.4 ... 1.0 mm at s = 0.9 ... 0.5. Seen: exact to
 // 5e-11 (lambda = 0), 1.6e-5 in sigma22 (3 MPa, s = 0.5), 2.4e-10 (100 MPa, s = 0.85). lambda = 3
-// MPa is exact to 2e-9 through s = 0.70 (across x = 1.4 mm at s = 0.8); from s = 0.614, as the top
-// face nears y = 1.1 mm, Newton stalls (relative residual 1.1e-7) and 95 steps are redone as half
-// steps, which keep it within 1.6e-5 (with 200 steps instead of 333 it is lost at s = 0.558, see
-// docs/accuracy.md, "Biaxial"). lambda = 100 MPa is lost near s = 0.82 (the DISABLED_ test
-// below). With V2 = V both faces cross grid lines together (the top-right corner): lambda = 0 is
-// checked there (8 steps from s = 0.512 redone as half steps, seen 1.3e-6 in J).
+// MPa is exact to 2e-9 through s = 0.70 (across x = 1.4 mm at s = 0.8); from s = 0.614, as the
+// right face nears x = 1.3 mm and the top face y = 1.1 mm, Newton stalls (relative residual
+// 1.1e-7; with 200 iterations it converges to a state where the top-right corner escapes into the
+// right wall) and 95 steps are redone as half steps, which keep it within 1.6e-5 (with 200 steps
+// instead of 333 it is lost at s = 0.558, see docs/accuracy.md, "Biaxial"). lambda = 100 MPa is
+// lost near s = 0.82 (the DISABLED_ test below). With V2 = V both faces cross grid lines together
+// (the top-right corner): lambda = 0 is checked there (8 steps from s = 0.512 redone as half steps,
+// seen 1.3e-6 in J).
 TEST(WallBlock, BiaxialBetweenTwoMovingFaceWallsKeepsTheExactState) {
   check_biaxial({std::tuple{0.0, 0.5, 333}, std::tuple{3e6, 0.5, 333}, std::tuple{1e8, 0.85, 100}},
                 0.2);
