@@ -5,9 +5,11 @@
 // force is -sigma22 times the width, and the elastic energy is the work of the top wall (minus
 // the backward-Euler dissipation of the right-endpoint rule, O(dt)). docs/accuracy.md says which
 // parts of the method each check needs: CPDI domains that follow F, the affine P2G, and walls that
-// act on the points' faces.
+// act on the points' faces. Variants: uniaxial stress (no side walls) and biaxial (the right wall
+// moving left too), each against its own closed form.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -22,9 +24,21 @@ namespace {
 
 struct BlockResult {
   double worst_J = 0, worst_sigma = 0, force_error = 0, energy_ratio = 0;
-  double worst_sigma11 = 0;   // max |sigma11| / |sigma22 exact| (uniaxial stress: 0) [-]
-  double last_step_work = 0;  // final force x wall travel of one step / wall work [-]
-  int retries = 0;            // steps redone as two half steps, as the app's step controller does
+  // max |sigma11 - exact| / |sigma11 exact| (biaxial), / |sigma22 exact| otherwise (uniaxial
+  // stress: sigma11 = 0) [-]
+  double worst_sigma11 = 0;
+  double side_force_error = 0;  // right wall (biaxial) [-]
+  // Over every committed step: the largest |J - J_exact|, and the first s where it, or any
+  // point's sigma11 or sigma22 error relative to max(|sigma11|, |sigma22|) exact, passed 1e-3
+  // (1 if never)
+  double run_worst_J = 0, lost_at = 1.0;
+  double first_retry_at = 1.0;  // s at the start of the first step redone as half steps [-]
+  double seconds = 0;           // wall-clock time of the run [s]
+  double last_step_work = 0;    // final force x wall travel of one step / wall work [-]
+  // (elastic + kinetic change) / the walls' work by the trapezoid rule on the step-end forces,
+  // which the exact state matches to O(dt^2) [-]
+  double trapezoid_ratio = 0;
+  int retries = 0;  // steps redone as two half steps, as the app's step controller does
   std::int64_t factorizations = 0, solves = 0;  // summed over the steps
   std::int64_t projected = 0;       // factorisations redone with the projected tangent (indefinite)
   double contact_dissipation = 0;   // wall work - work of the contact impulses (ledger) / wall work
@@ -32,6 +46,7 @@ struct BlockResult {
   double bulk_dissipation = 0;      // (-stress work on the grid - elastic change) / wall work
   bool converged = true;
   std::string failure;
+  std::string first_failure;  // why the first step redone as half steps failed
 };
 
 // Lateral stretch a of plane-strain uniaxial stress at vertical stretch s: sigma11 = 0, i.e.
@@ -46,45 +61,80 @@ double lateral_stretch(double lambda, double mu, double s) {
   return a;
 }
 
-// Block [0.5, 1.5] mm^2 (h = 0.1 mm, 2x2 points per cell), top wall down at V = 0.4 m/s to
-// s = s_end in `steps` steps (theta = 1). With side walls (uniaxial strain) on a 2 mm grid; without
-// (`side_walls` false: uniaxial stress, sides free) on a 4 mm grid with the block centred at
-// x = 2 mm, starting with the lateral velocity of the quasi-static path at s = 1,
-// v_x = λ/(λ + 2μ) V (x - 2 mm)/H0 (the linearised sigma11 = 0). `offset` [m] moves the block
-// sideways (a multiple of the point spacing h/2: lattice seeding keeps the sites on that lattice).
-BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall_points,
-                    double s_end, int steps, bool modified_newton = false, bool side_walls = true,
-                    double offset = 0.0) {
+// How the block is loaded: top wall down at V = 0.4 m/s to s = s_end in `steps` steps (theta = 1).
+struct Squeeze {
+  double lambda = 0;  // [Pa]
+  double s_end = 0.5;
+  int steps = 333;
+  grid::ShapeKind shape = grid::ShapeKind::kCpdi;
+  bool affine = true, wall_points = true, modified_newton = false;
+  // false: uniaxial stress (top and bottom walls only, sides free)
+  bool side_walls = true;
+  // V2 [m/s]: the right wall moves left at V2 (biaxial; needs side walls)
+  double side_speed = 0;
+  // [m]: moves the block sideways (a multiple of the point spacing h/2: lattice seeding keeps the
+  // sites on that lattice)
+  double offset = 0;
+  // Newton's relative residual and increment, and the contact impulses' relative change
+  double residual_tolerance = 1e-12, impulse_tolerance = 1e-12;
+};
+
+// Block [0.5, 1.5] mm^2 (h = 0.1 mm, 2x2 points per cell). With side walls (uniaxial strain, or
+// biaxial when the right wall moves left at V2, starting from v_x = -V2 (x - 0.5 mm)/W0) on a
+// 2 mm grid; without (uniaxial stress) on a 4 mm grid with the block centred at x = 2 mm,
+// starting with the lateral velocity of the quasi-static path at s = 1,
+// v_x = λ/(λ + 2μ) V (x - 2 mm)/H0 (the linearised sigma11 = 0).
+BlockResult squeeze(const Squeeze& c) {
+  const auto start = std::chrono::steady_clock::now();
+  const double lambda = c.lambda, s_end = c.s_end;
+  const int steps = c.steps;
+  const bool side_walls = c.side_walls;
   constexpr double mu = 1.5e6, rho = 990.0, h = 1e-4, lo = 5e-4, hi = 1.5e-3, V = 0.4;
+  const double V2 = c.side_speed;
   // x of the block's left edge minus lo [m]
-  const double shift = (side_walls ? 0.0 : 1.5e-3) + offset;
+  const double shift = (side_walls ? 0.0 : 1.5e-3) + c.offset;
   const double xc = lo + shift + 0.5 * (hi - lo), rate = lambda / (lambda + 2 * mu) * V / (hi - lo);
   auto model =
       test_support::make_model(h, side_walls ? 20 : 40, 20, "neo_hookean", lambda, mu, rho);
   test_support::add_box(
       model, Vec<2>(lo + shift, lo), Vec<2>(hi + shift, hi), 2, [&](const Vec<2>& x) {
-        return Vec<2>(side_walls ? 0.0 : rate * (x[0] - xc), -V * (x[1] - lo) / (hi - lo));
+        const double vx = side_walls ? -V2 * (x[0] - lo) / (hi - lo) : rate * (x[0] - xc);
+        return Vec<2>(vx, -V * (x[1] - lo) / (hi - lo));
       });
   mpm::Settings<2> s;
-  s.shape = shape;
-  s.affine = affine;
-  s.modified_newton = modified_newton;
+  s.shape = c.shape;
+  s.affine = c.affine;
+  s.modified_newton = c.modified_newton;
   s.theta = 1.0;
-  s.residual_tolerance = s.increment_tolerance = 1e-12;
+  s.residual_tolerance = s.increment_tolerance = c.residual_tolerance;
   s.contact.enabled = true;
-  s.contact.wall_points = wall_points;
+  s.contact.wall_points = c.wall_points;
   s.contact.gs.tolerance = 1e-12;
-  s.contact.impulse_tolerance = 1e-12;
+  s.contact.impulse_tolerance = c.impulse_tolerance;
   s.contact.walls = {{"bottom", Vec<2>(0, lo), Vec<2>(0, 1), Vec<2>::Zero(), 0.0},
                      {"top", Vec<2>(0, hi), Vec<2>(0, -1), Vec<2>(0, -V), 0.0},
                      {"left", Vec<2>(lo, 0), Vec<2>(1, 0), Vec<2>::Zero(), 0.0},
-                     {"right", Vec<2>(hi, 0), Vec<2>(-1, 0), Vec<2>::Zero(), 0.0}};
+                     {"right", Vec<2>(hi, 0), Vec<2>(-1, 0), Vec<2>(-V2, 0), 0.0}};
   if (!side_walls) s.contact.walls.resize(2);
   mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
   const double H0 = hi - lo, dt = (1.0 - s_end) * H0 / V / steps;
   const auto d0 = mpm::diagnostics(model);
   BlockResult r;
-  double work = 0, t = 0, force = 0, contact_work = 0, transfer = 0, stress_work = 0;
+  // The closed form at time t: stretches a, s, J = a s and sigma11, sigma22 (method.md §7).
+  struct Exact {
+    double a, s, J, s11, s22;
+  };
+  const auto exact = [&](double time) {
+    Exact e;
+    e.s = 1.0 - V * time / H0;
+    e.a = !side_walls ? lateral_stretch(lambda, mu, e.s) : 1.0 - V2 * time / H0;
+    e.J = e.a * e.s;
+    e.s11 = (mu * (e.a * e.a - 1) + lambda * std::log(e.J)) / e.J;
+    e.s22 = (mu * (e.s * e.s - 1) + lambda * std::log(e.J)) / e.J;
+    return e;
+  };
+  double work = 0, trapezoid = 0, t = 0, force = 0, side_force = 0, contact_work = 0, transfer = 0,
+         stress_work = 0;
   // One step of size `step`; a failed step is redone as two half steps (up to 1/16), as the
   // app's controller cuts dt (docs/accuracy.md lists the failures this still meets).
   std::function<bool(double, int)> advance = [&](double step, int depth) {
@@ -95,7 +145,10 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
         r.failure = st.failure + " at t = " + std::to_string(t);
         return false;
       }
-      ++r.retries;
+      if (r.retries++ == 0) {
+        r.first_retry_at = exact(t).s;
+        r.first_failure = st.failure;
+      }
       return advance(step / 2, depth + 1) && advance(step / 2, depth + 1);
     }
     solver.commit();
@@ -106,29 +159,53 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
     stress_work += st.stress_work;
     r.solves += st.linear_solves;
     t += step;
+    const double force0 = force, side_force0 = side_force;
     force = st.wall_force[1][1];  // force of the grain on the top wall (+y) [N/m]
     work += force * V * step;     // the wall moves down at V against it
+    if (side_walls) {
+      side_force = st.wall_force[3][0];  // on the right wall (+x) [N/m]
+      work += side_force * V2 * step;    // which moves left at V2
+    }
+    trapezoid += 0.5 * ((force0 + force) * V + (side_force0 + side_force) * V2) * step;
+    const auto e = exact(t);
+    const double scale = std::max(std::abs(e.s11), std::abs(e.s22));
+    double worst = 0;
+    for (std::size_t p = 0; p < model.points.size(); ++p) {
+      const double dJ = std::abs(model.points.F[p].determinant() - e.J);
+      r.run_worst_J = std::max(r.run_worst_J, dJ);
+      worst = std::max({worst, dJ, std::abs(model.points.sigma[p](0, 0) - e.s11) / scale,
+                        std::abs(model.points.sigma[p](1, 1) - e.s22) / scale});
+    }
+    if (worst > 1e-3 && r.lost_at == 1.0) r.lost_at = e.s;
     return true;
   };
   for (int k = 0; k < steps; ++k)
     if (!advance(dt, 0)) {
       r.converged = false;
+      std::printf(
+          "  lambda %.3g MPa: failed at s = %.4f (%s), first half step at s = %.4f, "
+          "state lost at s = %.4f\n",
+          lambda / 1e6, exact(t).s, r.failure.c_str(), r.first_retry_at, r.lost_at);
       return r;
     }
-  const double sf = 1.0 - V * t / H0;
-  const double a = side_walls ? 1.0 : lateral_stretch(lambda, mu, sf), J = a * sf;
-  const double s22 = (mu * (sf * sf - 1) + lambda * std::log(J)) / J;
+  const auto e = exact(t);
+  const double sf = e.s, a = e.a, J = e.J, s11 = e.s11, s22 = e.s22;
+  const double s11_scale = V2 > 0 ? std::abs(s11) : std::abs(s22);
   for (std::size_t p = 0; p < model.points.size(); ++p) {
     r.worst_J = std::max(r.worst_J, std::abs(model.points.F[p].determinant() - J));
     r.worst_sigma =
         std::max(r.worst_sigma, std::abs(model.points.sigma[p](1, 1) - s22) / std::abs(s22));
     r.worst_sigma11 =
-        std::max(r.worst_sigma11, std::abs(model.points.sigma[p](0, 0)) / std::abs(s22));
+        std::max(r.worst_sigma11, std::abs(model.points.sigma[p](0, 0) - s11) / s11_scale);
   }
   r.force_error = std::abs(force - (-s22 * a * H0)) / std::abs(s22 * a * H0);
+  if (V2 > 0)
+    r.side_force_error = std::abs(side_force - (-s11 * sf * H0)) / std::abs(s11 * sf * H0);
   const auto d = mpm::diagnostics(model);
-  r.last_step_work = force * V * dt / work;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.last_step_work = (force * V + side_force * V2) * dt / work;
   r.energy_ratio = (d.elastic + d.kinetic - d0.elastic - d0.kinetic) / work;
+  r.trapezoid_ratio = (d.elastic + d.kinetic - d0.elastic - d0.kinetic) / trapezoid;
   r.contact_dissipation = (work - contact_work) / work;
   r.transfer_dissipation = transfer / work;
   r.bulk_dissipation = (-stress_work - (d.elastic - d0.elastic)) / work;
@@ -137,11 +214,18 @@ BlockResult squeeze(double lambda, grid::ShapeKind shape, bool affine, bool wall
       "top force error = %.2e, (elastic + kinetic change) / wall work = %.5f (one step's final "
       "work %.5f), contact "
       "dissipation / wall work = %.2e, transfers %.2e, bulk %.2e, %d steps "
-      "redone as half steps, %lld factorisations (%lld projected) for %lld solves\n",
+      "redone as half steps (first at s = %.4f), %lld factorisations (%lld projected) for %lld "
+      "solves; state lost (1e-3) at s = %.4f; %.1f s\n",
       lambda / 1e6, sf, r.worst_J, r.worst_sigma, r.force_error, r.energy_ratio, r.last_step_work,
       r.contact_dissipation, r.transfer_dissipation, r.bulk_dissipation, r.retries,
-      static_cast<long long>(r.factorizations), static_cast<long long>(r.projected),
-      static_cast<long long>(r.solves));
+      r.first_retry_at, static_cast<long long>(r.factorizations),
+      static_cast<long long>(r.projected), static_cast<long long>(r.solves), r.lost_at, r.seconds);
+  if (r.retries > 0) std::printf("  first half steps after: %s\n", r.first_failure.c_str());
+  if (V2 > 0)
+    std::printf(
+        "  biaxial a = %.4f: max rel. sigma11 error = %.2e, right force error = %.2e, (elastic + "
+        "kinetic change) / trapezoid wall work = %.6f\n",
+        a, r.worst_sigma11, r.side_force_error, r.trapezoid_ratio);
   return r;
 }
 
@@ -155,7 +239,7 @@ TEST(WallBlock, CpdiAffineFaceWallsKeepTheExactState) {
   // docs/accuracy.md): 100 MPa is checked to s = 0.85.
   for (const auto& [lambda, s_end, steps] :
        {std::tuple{0.0, 0.5, 333}, std::tuple{3e6, 0.5, 333}, std::tuple{1e8, 0.85, 100}}) {
-    const auto r = squeeze(lambda, grid::ShapeKind::kCpdi, true, true, s_end, steps);
+    const auto r = squeeze({.lambda = lambda, .s_end = s_end, .steps = steps});
     ASSERT_TRUE(r.converged) << r.failure;
     EXPECT_EQ(r.retries, 0);
     if (lambda > 0) {
@@ -184,9 +268,16 @@ TEST(WallBlock, CpdiAffineFaceWallsKeepTheExactState) {
 
 TEST(WallBlock, EachIngredientIsNeeded) {
   // Without any one of the three parts the exact state is lost within s = 0.8 (docs/accuracy.md).
-  const auto nodes = squeeze(3e6, grid::ShapeKind::kCpdi, true, false, 0.8, 60);
-  const auto linear = squeeze(3e6, grid::ShapeKind::kLinear, true, true, 0.8, 60);
-  const auto plain = squeeze(3e6, grid::ShapeKind::kCpdi, false, true, 0.8, 60);
+  const Squeeze all{.lambda = 3e6, .s_end = 0.8, .steps = 60};
+  auto without = all;
+  without.wall_points = false;
+  const auto nodes = squeeze(without);
+  without = all;
+  without.shape = grid::ShapeKind::kLinear;
+  const auto linear = squeeze(without);
+  without = all;
+  without.affine = false;
+  const auto plain = squeeze(without);
   EXPECT_GT(nodes.worst_sigma, 1e-2);
   EXPECT_GT(linear.worst_sigma, 1e-2);
   EXPECT_GT(plain.worst_sigma, 1e-5);
@@ -197,8 +288,9 @@ TEST(WallBlock, ModifiedNewtonKeepsTheExactStateWithFewerFactorisations) {
   // only the path to the converged state, not the state: the same closed form to the same
   // tolerance, with at most one factorisation per step (the residual never stalls here).
   const int steps = 133;
-  const auto full = squeeze(3e6, grid::ShapeKind::kCpdi, true, true, 0.8, steps, false);
-  const auto modified = squeeze(3e6, grid::ShapeKind::kCpdi, true, true, 0.8, steps, true);
+  const auto full = squeeze({.lambda = 3e6, .s_end = 0.8, .steps = steps});
+  const auto modified =
+      squeeze({.lambda = 3e6, .s_end = 0.8, .steps = steps, .modified_newton = true});
   ASSERT_TRUE(full.converged) << full.failure;
   ASSERT_TRUE(modified.converged) << modified.failure;
   EXPECT_LT(modified.worst_J, 1e-6);
@@ -217,8 +309,8 @@ namespace {
 void check_uniaxial_stress(std::initializer_list<std::tuple<double, double, int>> cases,
                            double offset, double j_tol) {
   for (const auto& [lambda, s_end, steps] : cases) {
-    const auto r =
-        squeeze(lambda, grid::ShapeKind::kCpdi, true, true, s_end, steps, false, false, offset);
+    const auto r = squeeze(
+        {.lambda = lambda, .s_end = s_end, .steps = steps, .side_walls = false, .offset = offset});
     ASSERT_TRUE(r.converged) << r.failure;
     std::printf("  uniaxial stress: max |sigma11| / |sigma22| = %.2e\n", r.worst_sigma11);
     EXPECT_LT(r.worst_J, j_tol);
@@ -256,4 +348,65 @@ TEST(WallBlock, DISABLED_UniaxialStressWithFreeSidesKeepsTheExactState) {
   // tolerances below.
   check_uniaxial_stress(
       {std::tuple{0.0, 0.5, 333}, std::tuple{3e6, 0.5, 333}, std::tuple{1e8, 0.5, 333}}, 0.0, 1e-3);
+}
+
+// Biaxial (docs/accuracy.md, "Biaxial"): four face walls, the top one down at V and the right one
+// left at V2, from the exact homogeneous velocity v = (-V2 (x - x_lo)/W0, -V (y - y_lo)/H0): F =
+// diag(a, s) at every instant, a = 1 - V2 t/W0, s = 1 - V t/H0, J = a s. After every step, every
+// point's J within 1e-3 and sigma11, sigma22 within 1e-3 of max(|sigma11|, |sigma22|); at the end,
+// each within 1e-3 of its own closed form, both moving walls' forces (-sigma22 a W0 on the top,
+// -sigma11 s H0 on the right) within 1e-3, and the elastic change equal to both walls' work by
+// the trapezoid rule within 1e-3 (backward Euler's right-end work exceeds it by half a step's).
+namespace {
+void check_biaxial(std::initializer_list<std::tuple<double, double, int>> cases,
+                   double side_speed) {
+  for (const auto& [lambda, s_end, steps] : cases) {
+    const auto r =
+        squeeze({.lambda = lambda, .s_end = s_end, .steps = steps, .side_speed = side_speed});
+    ASSERT_TRUE(r.converged) << r.failure;
+    EXPECT_EQ(r.lost_at, 1.0);
+    EXPECT_LT(r.worst_J, 1e-3);
+    EXPECT_LT(r.worst_sigma, 1e-3);
+    EXPECT_LT(r.worst_sigma11, 1e-3);
+    EXPECT_LT(r.force_error, 1e-3);
+    EXPECT_LT(r.side_force_error, 1e-3);
+    EXPECT_NEAR(r.trapezoid_ratio, 1.0, 1e-3);
+    EXPECT_LE(r.energy_ratio, 1.0 + 1e-9);
+    EXPECT_GT(r.energy_ratio, 1.0 - r.last_step_work);
+  }
+}
+}  // namespace
+
+// The right wall at V2 = V/2 (a = 0.75 at s = 0.5): its face crosses the grid lines x = 1.4 and
+// 1.3 mm at s = 0.8 and 0.6, the top face y = 1.4 ... 1.0 mm at s = 0.9 ... 0.5. Seen: exact to
+// 5e-11 (lambda = 0), 1.6e-5 in sigma22 (3 MPa, s = 0.5), 2.4e-10 (100 MPa, s = 0.85). lambda = 3
+// MPa is exact to 2e-9 through s = 0.70 (across x = 1.4 mm at s = 0.8); from s = 0.614, as the
+// right face nears x = 1.3 mm and the top face y = 1.1 mm, Newton stalls (relative residual
+// 1.1e-7; with 200 iterations it converges to a state where the top-right corner escapes into the
+// right wall) and 95 steps are redone as half steps, which keep it within 1.6e-5. That depends on
+// the path of the half steps: kept with 320, 330 and 336 steps, lost with 350 (s = 0.523) and 200
+// (s = 0.558); the sanitize build gives the same figures as release (docs/accuracy.md, "Biaxial").
+// lambda = 100 MPa is lost near s = 0.82 (the DISABLED_ test below). With V2 = V both faces cross
+// grid lines together (the top-right corner): lambda = 0 is checked there (8 steps from s = 0.512
+// redone as half steps, seen 1.3e-6 in J).
+TEST(WallBlock, BiaxialBetweenTwoMovingFaceWallsKeepsTheExactState) {
+  check_biaxial({std::tuple{0.0, 0.5, 333}, std::tuple{3e6, 0.5, 333}, std::tuple{1e8, 0.85, 100}},
+                0.2);
+  check_biaxial({std::tuple{0.0, 0.5, 333}}, 0.4);
+}
+
+// Open (docs/accuracy.md, "Biaxial"): the biaxial cases that lose the state, with the same
+// Newton and contact tolerances (1e-12) and the same dt as above (333 steps to s = 0.5). Seen:
+// - V2 = V/2, lambda = 100 MPa: first half steps at s = 0.841 (Newton stalls at a relative
+//   residual of 6e-11), state lost (by 1e-3) at s = 0.820, before the right face reaches its
+//   first grid line; at s = 0.5 J is off by 0.79, sigma22 by 105 %, the top force by 95 %, and
+//   the elastic change is 0.10 of the walls' work.
+// - V2 = V, lambda = 3 MPa: first half steps at s = 0.817 (both faces nearing grid lines), lost at
+//   s = 0.685; at s = 0.5 J off by 0.63, sigma22 by 114 %, top force by 47 %, energy 0.52.
+// - V2 = V, lambda = 100 MPa: first half steps at s = 0.920 (Newton diverges, residual 5e-3),
+//   lost at s = 0.908; at s = 0.5 J off by 0.82, sigma22 by 101 %.
+// Run it with --gtest_also_run_disabled_tests (8 minutes on one thread: thousands of half steps).
+TEST(WallBlock, DISABLED_BiaxialStiffOrWithEqualSpeedsKeepsTheExactState) {
+  check_biaxial({std::tuple{1e8, 0.5, 333}}, 0.2);
+  check_biaxial({std::tuple{3e6, 0.5, 333}, std::tuple{1e8, 0.5, 333}}, 0.4);
 }
