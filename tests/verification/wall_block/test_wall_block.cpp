@@ -386,13 +386,12 @@ void check_biaxial(std::initializer_list<std::tuple<double, double, int>> cases,
 // right wall) and 95 steps are redone as half steps, which keep it within 1.6e-5. That depends on
 // the path of the half steps: kept with 320, 330 and 336 steps, lost with 350 (s = 0.523) and 200
 // (s = 0.558); the sanitize build gives the same figures as release (docs/accuracy.md, "Biaxial").
-// lambda = 100 MPa is lost near s = 0.82 (the DISABLED_ test below). With V2 = V both faces cross
-// grid lines together (the top-right corner): lambda = 0 is checked there (8 steps from s = 0.512
-// redone as half steps, seen 1.3e-6 in J).
+// lambda = 100 MPa is lost near s = 0.82 (the DISABLED_ test below). The default suite checks only
+// what needs no half step: lambda = 3 MPa to s = 0.62 (before the stall), lambda = 0 to 0.5 and
+// 100 MPa to 0.85; the runs that rely on half steps are in the DISABLED_ test.
 TEST(WallBlock, BiaxialBetweenTwoMovingFaceWallsKeepsTheExactState) {
-  check_biaxial({std::tuple{0.0, 0.5, 333}, std::tuple{3e6, 0.5, 333}, std::tuple{1e8, 0.85, 100}},
+  check_biaxial({std::tuple{0.0, 0.5, 333}, std::tuple{3e6, 0.62, 253}, std::tuple{1e8, 0.85, 100}},
                 0.2);
-  check_biaxial({std::tuple{0.0, 0.5, 333}}, 0.4);
 }
 
 // Open (docs/accuracy.md, "Biaxial"): the biaxial cases that lose the state, with the same
@@ -405,8 +404,13 @@ TEST(WallBlock, BiaxialBetweenTwoMovingFaceWallsKeepsTheExactState) {
 //   s = 0.685; at s = 0.5 J off by 0.63, sigma22 by 114 %, top force by 47 %, energy 0.52.
 // - V2 = V, lambda = 100 MPa: first half steps at s = 0.920 (Newton diverges, residual 5e-3),
 //   lost at s = 0.908; at s = 0.5 J off by 0.82, sigma22 by 101 %.
+// - Kept only through half steps, whose path decides (above): V2 = V/2, lambda = 3 MPa to s = 0.5
+//   (95 half steps, 1.6e-5 in sigma22), and V2 = V, lambda = 0 (8 half steps from s = 0.512 where
+//   both faces cross grid lines together, seen 1.3e-6 in J).
 // Run it with --gtest_also_run_disabled_tests (8 minutes on one thread: thousands of half steps).
 TEST(WallBlock, DISABLED_BiaxialStiffOrWithEqualSpeedsKeepsTheExactState) {
+  check_biaxial({std::tuple{3e6, 0.5, 333}}, 0.2);
+  check_biaxial({std::tuple{0.0, 0.5, 333}}, 0.4);
   check_biaxial({std::tuple{1e8, 0.5, 333}}, 0.2);
   check_biaxial({std::tuple{3e6, 0.5, 333}, std::tuple{1e8, 0.5, 333}}, 0.4);
 }
