@@ -268,19 +268,31 @@ constexpr int kMaxBlock = 6;
 // (method.md §4), solved by trying the active sets in turn with a minimum-norm solve (the node's
 // contacts may be redundant: a light field pinched between two grains). Returns false, leaving
 // the impulses unchanged, when a contact has friction, k is out of range or no set fits.
+// The Delassus matrices W of the nodal blocks of one Gauss-Seidel solve, by the position of the
+// block's first contact in the sweep order: they do not change during the solve (the groups' G
+// and the normals are fixed), so each is made at the block's first visit, by the thread that
+// owns the block's run (GsSettings::node_blocks).
+struct BlockCache {
+  std::vector<Eigen::Matrix<double, kMaxBlock, kMaxBlock>> W;
+  std::vector<char> ready;
+};
+
 template <int Dim>
-bool solve_node_block(Problem<Dim>& p, SlotVelocities<Dim>& v, const std::int32_t* idx, int k) {
+bool solve_node_block(Problem<Dim>& p, SlotVelocities<Dim>& v, const std::int32_t* idx, int k,
+                      BlockCache* cache, std::size_t at) {
   if (k < 2 || k > kMaxBlock) return false;
   using MatK = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxBlock, kMaxBlock>;
   using VecK = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxBlock, 1>;
   MatK W(k, k);
   VecK u(k), p0(k);
+  const bool cached = cache && cache->ready[at];
   for (int i = 0; i < k; ++i) {
     const Contact<Dim>& c = p.contacts[idx[i]];
     if (c.friction != 0.0) return false;
     const Vec<Dim> va = c.a >= 0 ? v[c.a] : c.wall_velocity;
     u[i] = c.normal.dot(v[c.b] - va) + c.gap / p.dt;
     p0[i] = c.impulse.dot(c.normal);
+    if (cached) continue;
     for (int j = 0; j < k; ++j) {
       const Contact<Dim>& d = p.contacts[idx[j]];
       // Velocity of (b_c - a_c) per unit impulse n_d on b_d and -n_d on a_d.
@@ -288,6 +300,12 @@ bool solve_node_block(Problem<Dim>& p, SlotVelocities<Dim>& v, const std::int32_
                          cross_block(p, c.a, d.b) + cross_block(p, c.a, d.a);
       W(i, j) = c.normal.dot(R * d.normal);
     }
+  }
+  if (cached) {
+    W = cache->W[at].topLeftCorner(k, k);
+  } else if (cache) {
+    cache->W[at].topLeftCorner(k, k) = W;
+    cache->ready[at] = 1;
   }
   const VecK base = u - W * p0;  // w = base + W p
   // Every active set, the one with the smallest violation of p >= 0, w >= 0 (relative to each
@@ -356,7 +374,7 @@ bool solve_node_block(Problem<Dim>& p, SlotVelocities<Dim>& v, const std::int32_
 
 template <int Dim>
 void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const SweepOrder& runs, StageTimers* timers,
-           double omega, bool node_blocks, bool threads) {
+           double omega, bool node_blocks, bool threads, BlockCache* cache) {
   const ThreadedRegion threaded(timers, threads);
   for (std::size_t ph = 0; ph + 1 < runs.phase.size(); ++ph)
 #pragma omp parallel for schedule(dynamic, 8) if (threads)
@@ -368,7 +386,8 @@ void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const SweepOrder& runs, Stag
           while (block_end < runs.start[r + 1] &&
                  p.slots[p.contacts[runs.order[block_end]].b].node == node)
             ++block_end;
-          if (solve_node_block(p, v, runs.order.data() + k, block_end - k)) {
+          if (solve_node_block(p, v, runs.order.data() + k, block_end - k, cache,
+                               static_cast<std::size_t>(k))) {
             k = block_end - 1;
             continue;
           }
@@ -406,11 +425,16 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& 
   const SweepOrder own = settings.order ? SweepOrder{} : sweep_order(p);
   const SweepOrder& runs = settings.order ? *settings.order : own;
   const double work = static_cast<double>(p.contacts.size());
+  BlockCache cache;
+  if (settings.node_blocks) {
+    cache.W.resize(runs.order.size());
+    cache.ready.assign(runs.order.size(), 0);
+  }
   while (r.sweeps < settings.max_sweeps) {
     const bool threads = tuner ? tuner->threaded() : can_thread;
     const auto t0 = std::chrono::steady_clock::now();
     sweep(p, v, runs, settings.timers, r.sweeps >= settings.relax_after ? settings.relaxation : 1.0,
-          settings.node_blocks, threads);
+          settings.node_blocks, threads, &cache);
     ++r.sweeps;
     r.error = error_now(threads);
     if (tuner)

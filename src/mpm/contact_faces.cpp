@@ -260,7 +260,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
           const Vec<Dim> xt = xf + 0.5 / len * nu;
           bool interior = false;
           near(X, xt, 1, [&](std::int64_t q) {
-            if (interior || q == p) return;
+            if (interior || q == p || (points_.x[q] - xt).norm() > point_reach_[q]) return;
             const Mat<Dim> Dq = points_.F[q] * points_.domain[q];
             interior = (Dq.inverse() * (xt - points_.x[q])).cwiseAbs().maxCoeff() <= 1.0;
           });
