@@ -27,6 +27,18 @@ def column(rows, name, run):
     return np.array([float(r[name]) if r[name] != "" else np.nan for r in rows if r["run"] == run])
 
 
+def label_jamming(ax, fit, colour, k):
+    """The jamming packing fraction of one run: a dotted vertical line, labelled Φ_J."""
+    if not fit["phi_J"]:
+        return
+    phi_j = float(fit["phi_J"])
+    ax.axvline(phi_j, color=colour, lw=0.6, ls=":")
+    ax.annotate(rf"$\Phi_J$ = {phi_j:.3f}", xy=(phi_j, 0.5 - 0.06 * k),
+                xycoords=("data", "axes fraction"), xytext=(3, 0), textcoords="offset points",
+                color=colour, fontsize=7, va="center",
+                bbox=dict(fc="white", ec="none", alpha=0.8, pad=1))
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit(__doc__)
@@ -52,8 +64,7 @@ def main():
         ax.plot(phi, column(fig4, "eps", run), "-", color=c, label=f"ε, {labels[run]}")
         ax.plot(phi, column(fig4, "ln_Vs_Vs0", run), "--", color=c,
                 label=f"ln(Vs/Vs0), {labels[run]}")
-        if f["phi_J"]:
-            ax.axvline(float(f["phi_J"]), color=c, lw=0.6, ls=":")
+        label_jamming(ax, f, c, k)
     ax.set_xlabel("Φ")
     ax.set_ylabel("ε,  ln(Vs/Vs0)")
     ax.set_title("Vertical strain and grain volume change")
@@ -71,6 +82,7 @@ def main():
         y = column(fig5, "sigma_over_Mp", run)
         model = column(fig5, "model", run)
         ax.plot(phi, y, ".", ms=2.5, color=c, label=f"{labels[run]}")
+        label_jamming(ax, f, c, k)
         if f["c1"]:
             ok = np.isfinite(model)
             ax.plot(phi[ok], model[ok], "-", color="k" if len(fits) == 1 else c, lw=1.2,
