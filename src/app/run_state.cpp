@@ -239,9 +239,13 @@ mpm::Model<Dim> restore_model(const io::Config& cfg, const checkpoint::State& s,
       throw refuse(fmt::format("point {} lies outside the grid", i));
   const auto ng = static_cast<std::int32_t>(model.grains.size());
   const auto nwall = static_cast<std::int32_t>(cfg.walls.size());
+  // Warm-start keys: a grid node, -1 - a grid cell (face walls) or -1 - a face number
+  // point * 2 Dim + 2 axis + side (grain faces, ImplicitSolver::grain_face_contacts).
+  const std::int64_t lowest =
+      -std::max<std::int64_t>(model.grid.node_count(), 2 * Dim * static_cast<std::int64_t>(n));
   for (std::size_t k = 0; k < s.warm_node.size(); ++k)
-    if (s.warm_node[k] < -model.grid.node_count() || s.warm_node[k] >= model.grid.node_count() ||
-        s.warm_b[k] < 0 || s.warm_b[k] >= ng || s.warm_a[k] >= ng || s.warm_a[k] < -nwall)
+    if (s.warm_node[k] < lowest || s.warm_node[k] >= model.grid.node_count() || s.warm_b[k] < 0 ||
+        s.warm_b[k] >= ng || s.warm_a[k] >= ng || s.warm_a[k] < -nwall)
       throw refuse(
           fmt::format("contact warm-start entry {} names a node or body that does not exist", k));
   if (s.wall_point.size() != Dim * cfg.walls.size())

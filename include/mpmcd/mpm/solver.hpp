@@ -63,9 +63,11 @@ struct StepStats {
 /// A contact impulse of the last converged step, used to warm start the next one.
 template <int Dim>
 struct WarmImpulse {
-  std::int64_t node = 0;  ///< global grid node, or -1 - grid cell of a face contact [-]
-  std::int32_t a = 0;     ///< body a: grain >= 0 or wall -1 - index [-]
-  std::int32_t b = 0;     ///< grain b [-]
+  /// global grid node, -1 - grid cell of a face wall contact, or -1 - face number
+  /// (point * 2 Dim + 2 axis + side) of a grain face contact [-]
+  std::int64_t node = 0;
+  std::int32_t a = 0;                   ///< body a: grain >= 0 or wall -1 - index [-]
+  std::int32_t b = 0;                   ///< grain b [-]
   Vec<Dim> impulse = Vec<Dim>::Zero();  ///< impulse on b over the step [N s] (2D: N s/m)
 };
 

@@ -38,7 +38,9 @@ fs::path scratch(const std::string& name) {
 // Two gel disks thrown at each other in a box of three walls under gravity: they collide at
 // about step 12, bounce off each other and the side walls (contacts all along, so warm-start
 // impulses matter). About 3 ms per step.
-fs::path write_case(const fs::path& dir, int steps, const std::string& checkpoint) {
+// `contact`: more lines of the [contact] table.
+fs::path write_case(const fs::path& dir, int steps, const std::string& checkpoint,
+                    const std::string& contact = "") {
   const fs::path p = dir / "pair.toml";
   std::ofstream(p) << "[simulation]\nname = \"pair\"\n"
                       "[grid]\norigin = [0.0, 0.0]\nextent = [0.02, 0.012]\ncell_size = 0.001\n"
@@ -55,9 +57,9 @@ fs::path write_case(const fs::path& dir, int steps, const std::string& checkpoin
                       "[[walls]]\nname = \"right\"\npoint = [0.0185, 0.0]\nnormal = [-1.0, 0.0]\n"
                       "[loads]\ngravity = [0.0, -9.81]\n"
                       "[time]\ndt = 2e-5\nend_time = "
-                   << steps * 2e-5
-                   << "\n[contact]\nfriction = 0.3\n"
-                      "[output]\nfolder = \"out\"\nvtu_interval = 1e-4\n"
+                   << steps * 2e-5 << "\n[contact]\nfriction = 0.3\n"
+                   << contact
+                   << "[output]\nfolder = \"out\"\nvtu_interval = 1e-4\n"
                       "[checkpoint]\n"
                    << checkpoint;
   return p;
@@ -165,12 +167,14 @@ fs::path reference(const fs::path& dir, int steps, const std::string& checkpoint
 
 }  // namespace
 
-// In process, deterministic split: N steps against N/2 (--stop-after) + restart to N.
-TEST(Restart, StopHalfWayAndResumeIsBitwise) {
+namespace {
+// In process, deterministic split: N steps against N/2 (--stop-after) + restart to N, with
+// `contact` added to the [contact] table.
+void stop_half_way_and_resume(const std::string& name, const std::string& contact) {
   mpmcd::setup_logging(mpmcd::Verbosity::kQuiet);
-  const fs::path dir = scratch("half");
+  const fs::path dir = scratch(name);
   const int n = 60;
-  const fs::path in = write_case(dir, n, "keep = 5\n");
+  const fs::path in = write_case(dir, n, "keep = 5\n", contact);
   const auto cfg = mpmcd::io::load_config(in.string());
   mpmcd::app::RunOptions opt;
   opt.threads = 1;
@@ -197,6 +201,17 @@ TEST(Restart, StopHalfWayAndResumeIsBitwise) {
   EXPECT_EQ(second.steps, n);
   EXPECT_EQ(second.output_dir, (dir / "split").string());
   expect_identical_runs(dir / "full", dir / "split", n);
+}
+}  // namespace
+
+TEST(Restart, StopHalfWayAndResumeIsBitwise) {
+  stop_half_way_and_resume("half", "");
+}
+
+// Contacts on the points' faces (walls and grains): their warm-start keys are face numbers, which
+// the checkpoint check refused before 2026-11-25 ("names a node that does not exist").
+TEST(Restart, StopHalfWayAndResumeWithFaceContactsIsBitwise) {
+  stop_half_way_and_resume("half_faces", "wall_contact = \"points\"\ngrain_contact = \"faces\"\n");
 }
 
 // The real binary: SIGTERM after some progress -> exit 4 and the resume line; resuming it gives
