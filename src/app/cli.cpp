@@ -146,6 +146,8 @@ int run_cli(int argc, char** argv) {
     } else if (*check) {
       const io::Config cfg = io::load_config(check_input);
       const auto model = build_model(cfg);
+      // The settings' checks too (e.g. the active-set solver with friction), as `run` makes them.
+      check_walls_enclose(cfg, model, build_settings(cfg, model));
       std::cout << fmt::format("{}: valid ({} grains, {} material points)\n", check_input,
                                model.grains.size(), model.points.size());
     } else if (*pack) {

@@ -288,6 +288,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
   c.wall_range = cfg.contact.wall_range;
   c.wall_points = cfg.contact.wall_contact == "points";
   c.grain_faces = cfg.contact.grain_contact == "faces";
+  c.active_set = cfg.contact.solver == "active_set";
   // Delassus operator: the lumped 1/m_I is accurate when inertia dominates a step (theta c_p dt/h
   // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered
   // contact-Newton loop converging in a few iterations.
@@ -310,6 +311,25 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
   }
   for (const auto& w : cfg.walls)
     c.walls.push_back({w.name, vec2(w.point), vec2(w.normal), vec2(w.velocity), w.friction});
+  // The active-set solver solves the normal impulses only: refuse friction rather than drop it.
+  if (c.active_set) {
+    if (cfg.contact.friction != 0.0)
+      throw InputError(cfg.source_path, 0, "contact.solver",
+                       "solver = \"active_set\" solves frictionless contacts only, but "
+                       "contact.friction is not 0: use solver = \"gauss_seidel\"");
+    for (const auto& p : cfg.contact.pairs)
+      if (p.friction != 0.0)
+        throw InputError(cfg.source_path, p.line, "contact.solver",
+                         "solver = \"active_set\" solves frictionless contacts only, but a "
+                         "[[contact.pairs]] friction is not 0: use solver = \"gauss_seidel\"");
+    for (const auto& w : cfg.walls)
+      if (w.friction != 0.0)
+        throw InputError(cfg.source_path, w.line, "contact.solver",
+                         fmt::format("solver = \"active_set\" solves frictionless contacts only, "
+                                     "but wall \"{}\" has friction: use solver = "
+                                     "\"gauss_seidel\"",
+                                     w.name));
+  }
   return s;
 }
 

@@ -361,6 +361,14 @@ Schema build_schema() {
                        "rank only for now; docs/contact.md)")
            .one_of({"nodes", "faces"})
            .default_of_member(),
+       KeySpec::string("solver", &ContactSection::solver,
+                       "contact solver: \"gauss_seidel\" (nonlinear Gauss-Seidel, any friction) "
+                       "or \"active_set\" (frictionless only: the normal impulses' complementarity "
+                       "problem by block principal pivoting with a sparse LDL^T, whose cost does "
+                       "not grow with near-redundant contacts such as grain_contact = \"faces\"; "
+                       "one MPI rank only for now; docs/contact.md)")
+           .one_of({"gauss_seidel", "active_set"})
+           .default_of_member(),
        KeySpec::string("delassus", &ContactSection::delassus,
                        "contact compliance: \"grain\" (each grain's exact linearised response "
                        "from its factorised Newton matrix; direct solvers), \"lumped\" (1/m_I), "

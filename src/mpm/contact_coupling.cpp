@@ -9,6 +9,7 @@
 #include <tuple>
 #include <vector>
 
+#include "mpmcd/contact/active_set.hpp"
 #include "solver_detail.hpp"
 
 namespace mpmcd::mpm {
@@ -232,6 +233,14 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   }
   std::vector<Vec<Dim>> old(problem_.contacts.size());
   for (std::size_t c = 0; c < old.size(); ++c) old[c] = problem_.contacts[c].impulse;
+  // With the active-set solver the staggering's impulse change is measured on the grains' nodal
+  // impulses, which the contact problem determines uniquely, not on the contacts' impulses,
+  // which redundant contacts (two grains' faces on one interface) share in a way that may drift
+  // from one Newton iteration to the next (docs/contact.md).
+  const bool nodal_change = settings_.contact.active_set;
+  std::vector<std::vector<Vec<Dim>>> old_nodal;
+  if (nodal_change)
+    for (const auto& w : work_) old_nodal.push_back(w->P);
   contact::GsResult r;
   // Debugging (docs/contact.md): MPMCD_WRITE_STALLED_PROBLEM=<folder> writes each problem whose
   // Gauss-Seidel does not converge, as given (warm start), for contact::read_problem.
@@ -246,7 +255,8 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     }
     contact::GsSettings gs = gs_settings();
     gs.order = &sweep_order_;
-    r = contact::solve_gauss_seidel(problem_, gs);
+    r = settings_.contact.active_set ? contact::solve_active_set(problem_, gs)
+                                     : contact::solve_gauss_seidel(problem_, gs);
   }
   if (stalled_dir && !r.converged) {
     static int written = 0;
@@ -306,6 +316,17 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   if (!problem_.groups.empty()) spread_slot_impulses();
   for (std::size_t g = 0; g < work_.size(); ++g)
     if (dv2[g] >= 0.0) work_[g]->impulses_changed(dv2[g]);
+  if (nodal_change) {
+    double nodal_num = 0, nodal_den = 0;
+    for (std::size_t g = 0; g < work_.size(); ++g)
+      for (std::size_t a = 0; a < work_[g]->P.size(); ++a) {
+        const Vec<Dim>& P = work_[g]->P[a];
+        const Vec<Dim> P_old = a < old_nodal[g].size() ? old_nodal[g][a] : Vec<Dim>::Zero();
+        nodal_num += (P - P_old).squaredNorm();
+        nodal_den += P.squaredNorm();
+      }
+    return detail::relative_change(nodal_num, nodal_den, gs_converged_);
+  }
   return detail::relative_change(num, den, gs_converged_);
 }
 

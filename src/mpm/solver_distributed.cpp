@@ -40,6 +40,10 @@ void ImplicitSolver<Dim>::set_distribution(const parallel::Comm* comm, std::vect
     throw InputError("", 0, "contact.grain_contact",
                      "grain-grain contact at the points' faces (\"faces\") runs on one rank for "
                      "now: use grain_contact = \"nodes\" on several ranks");
+  if (distributed() && settings_.contact.enabled && settings_.contact.active_set)
+    throw InputError("", 0, "contact.solver",
+                     "the active-set contact solver runs on one rank for now: use solver = "
+                     "\"gauss_seidel\" on several ranks");
   if (distributed() && settings_.contact.enabled && settings_.contact.grain_compliance &&
       settings_.linear_solver != LinearSolverKind::kCg)
     throw InputError("", 0, "contact.delassus",

@@ -97,6 +97,7 @@ struct GsSettings {
 /// Gauss-Seidel outcome.
 struct GsResult {
   int sweeps = 0;          ///< sweeps done
+  int pivots = 0;          ///< active-set pivoting steps (solve_active_set) [-]
   double error = 0;        ///< final error(problem) [-]
   bool converged = false;  ///< error <= tolerance
 };

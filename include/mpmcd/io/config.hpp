@@ -125,6 +125,7 @@ struct ContactSection {
   double wall_range = 1.0;          ///< grain nodes within this many cells of a wall take part [-]
   std::string wall_contact = "nodes";     ///< where walls act: "nodes" or "points" (point faces)
   std::string grain_contact = "nodes";    ///< where grains meet: "nodes" or "faces" (point faces)
+  std::string solver = "gauss_seidel";    ///< contact solver: "gauss_seidel" or "active_set" [-]
   std::string delassus = "auto";          ///< "grain" (exact grain compliance), "lumped" or "auto"
   std::vector<ContactPairSection> pairs;  ///< per material-pair friction
 };

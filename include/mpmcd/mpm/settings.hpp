@@ -68,7 +68,10 @@ struct ContactSettings {
   /// boundary face of either grain's points near the other grain against the other grain's
   /// velocity at the face's corners, along the face's normal. One MPI rank only for now.
   bool grain_faces = false;
-  contact::GsSettings gs;           ///< Gauss-Seidel tolerance and sweep limit
+  contact::GsSettings gs;  ///< Gauss-Seidel tolerance and sweep limit
+  /// Solve each contact problem by block principal pivoting on the normal impulses
+  /// (contact::solve_active_set; frictionless problems, one MPI rank) instead of Gauss-Seidel.
+  bool active_set = false;
   double impulse_tolerance = 1e-6;  ///< relative change of impulses between Newton iterations [-]
   /// Delassus operator: true = each grain's exact compliance at its contact nodes from its
   /// factorised Newton matrix (direct linear solvers), false = lumped 1/m_I.

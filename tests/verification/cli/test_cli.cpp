@@ -692,3 +692,32 @@ TEST(Cli, GrainOutputsAtSnapshotTimes) {
   EXPECT_NE(b.output.find("grains"), std::string::npos) << b.output;
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
+
+// The active-set contact solver solves frictionless contacts only: friction anywhere (the
+// default grain pair, a material pair, a wall) is refused at input with exit 2, naming the key,
+// not dropped. Without friction the same input runs.
+TEST(Cli, ActiveSetSolverRefusesFriction) {
+  const fs::path dir = scratch("active_set");
+  const std::string grains =
+      "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.01, 0.006]\n"
+      "radius = 0.003\n[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\n"
+      "center = [0.01, 0.0125]\nradius = 0.003\n"
+      "[[walls]]\nname = \"floor\"\npoint = [0.0, 0.002]\nnormal = [0.0, 1.0]\n";
+  const std::string time = "[time]\ndt = 1e-5\nend_time = 2e-5\n";
+  const auto input = [&](const std::string& contact, const std::string& wall) {
+    return write_input(dir, grains + wall + "[contact]\nsolver = \"active_set\"\n" + contact, time);
+  };
+  for (const auto& [contact, wall] :
+       {std::pair<std::string, std::string>{"friction = 0.3\n", ""},
+        std::pair<std::string, std::string>{"", "friction = 0.5\n"}}) {
+    for (const std::string cmd : {"check ", "run "}) {
+      const Result r = run(cmd + input(contact, wall).string());
+      EXPECT_EQ(r.code, 2) << cmd << r.output;
+      EXPECT_NE(r.output.find("key 'contact.solver'"), std::string::npos) << r.output;
+      EXPECT_NE(r.output.find("frictionless contacts only"), std::string::npos) << r.output;
+      EXPECT_FALSE(fs::exists(dir / "out"));
+    }
+  }
+  const Result ok = run("run " + input("", "").string());
+  EXPECT_EQ(ok.code, 0) << ok.output;
+}

@@ -1,0 +1,244 @@
+#include "mpmcd/contact/active_set.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace mpmcd::contact {
+
+namespace {
+// Proximal steps of one solve before it is left to Gauss-Seidel.
+constexpr int kMaxProximalSteps = 30;
+// Block pivots of one proximal step before the shift grows (cycling on an ill-conditioned W_AA).
+constexpr int kMaxPivots = 30;
+}  // namespace
+
+template <int Dim>
+NormalSystem normal_system(const Problem<Dim>& p) {
+  const auto m = static_cast<Eigen::Index>(p.contacts.size());
+  NormalSystem sys;
+  sys.b.resize(m);
+  sys.p.resize(m);
+  // A contact's relative normal velocity n_c . (v_B - v_A) responds to impulses through the
+  // slots it shares with other contacts: those of one compliance group (G blocks) or one lumped
+  // slot (I / m). Each such resource lists its (contact, slot, sign) entries; every pair of
+  // entries adds sign_e sign_f n_e . R(slot_e, slot_f) n_f to W (method.md §4).
+  struct Entry {
+    std::int32_t contact, slot;
+    double sign;
+  };
+  const std::size_t ng = p.groups.size();
+  std::vector<std::vector<Entry>> by_resource(ng + p.slots.size());
+  const auto resource = [&](std::int32_t s) {
+    return p.slots[s].group >= 0 ? static_cast<std::size_t>(p.slots[s].group)
+                                 : ng + static_cast<std::size_t>(s);
+  };
+  for (Eigen::Index c = 0; c < m; ++c) {
+    const Contact<Dim>& k = p.contacts[static_cast<std::size_t>(c)];
+    const Vec<Dim> va = k.a >= 0 ? p.slots[k.a].v_free : k.wall_velocity;
+    sys.b[c] = k.normal.dot(p.slots[k.b].v_free - va) + k.gap / p.dt;
+    sys.p[c] = k.impulse.dot(k.normal);
+    by_resource[resource(k.b)].push_back({static_cast<std::int32_t>(c), k.b, 1.0});
+    if (k.a >= 0) by_resource[resource(k.a)].push_back({static_cast<std::int32_t>(c), k.a, -1.0});
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (std::size_t r = 0; r < by_resource.size(); ++r) {
+    const auto& list = by_resource[r];
+    for (const Entry& e : list) {
+      const Vec<Dim>& ne = p.contacts[e.contact].normal;
+      for (const Entry& f : list) {
+        const Vec<Dim>& nf = p.contacts[f.contact].normal;
+        double v;
+        if (r >= ng) {
+          v = ne.dot(nf) / p.slots[e.slot].mass;  // one lumped slot: R = I / m
+        } else {
+          const Eigen::MatrixXd& G = p.groups[r].G;
+          v = ne.dot(
+              G.template block<Dim, Dim>(Dim * p.slots[e.slot].local, Dim * p.slots[f.slot].local) *
+              nf);
+        }
+        triplets.emplace_back(e.contact, f.contact, e.sign * f.sign * v);
+      }
+    }
+  }
+  sys.W.resize(m, m);
+  sys.W.setFromTriplets(triplets.begin(), triplets.end());
+  return sys;
+}
+
+namespace {
+
+// Factorisations of W_AA + delta I (sparse LDL^T), the last one kept: the proximal steps of one
+// solve (and the pivots that return to a set) reuse it while the active set is the same.
+class ShiftedSolver {
+ public:
+  ShiftedSolver(const NormalSystem& sys, double delta) : sys_(sys), delta_(delta) {}
+
+  // A new shift delta [s/kg]; the next solve factorises.
+  void set_shift(double delta) {
+    delta_ = delta;
+    factored_.clear();
+  }
+
+  // p_A = (W_AA + delta I)^-1 r_A with r = -q on the contacts `active`, 0 elsewhere; false
+  // when the factorisation fails.
+  bool solve(const std::vector<std::int32_t>& active, const Eigen::VectorXd& q,
+             Eigen::VectorXd& p) {
+    const auto na = static_cast<Eigen::Index>(active.size());
+    p.setZero();
+    if (na == 0) return true;
+    if (active != factored_) {
+      factored_.clear();
+      std::vector<std::int32_t> where(static_cast<std::size_t>(sys_.W.rows()), -1);
+      for (Eigen::Index i = 0; i < na; ++i) where[static_cast<std::size_t>(active[i])] = i;
+      std::vector<Eigen::Triplet<double>> t;
+      for (Eigen::Index i = 0; i < na; ++i)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(sys_.W, active[i]); it; ++it) {
+          const std::int32_t j = where[static_cast<std::size_t>(it.row())];
+          if (j >= 0) t.emplace_back(j, i, it.value());
+        }
+      Waa_.resize(na, na);
+      Waa_.setFromTriplets(t.begin(), t.end());
+      ldlt_.setShift(delta_);
+      ldlt_.compute(Waa_);
+      if (ldlt_.info() != Eigen::Success) return false;
+      factored_ = active;
+      ++factorisations;
+    }
+    Eigen::VectorXd rhs(na);
+    for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -q[active[i]];
+    Eigen::VectorXd x = ldlt_.solve(rhs);
+    // One step of iterative refinement against the shifted matrix.
+    x += ldlt_.solve(rhs - Waa_ * x - delta_ * x);
+    if (!x.allFinite()) return false;
+    for (Eigen::Index i = 0; i < na; ++i) p[active[i]] = x[i];
+    return true;
+  }
+
+  int factorisations = 0;  ///< LDL^T factorisations done [-]
+
+ private:
+  const NormalSystem& sys_;
+  double delta_;
+  std::vector<std::int32_t> factored_;
+  Eigen::SparseMatrix<double> Waa_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+};
+
+// The largest violation of p >= 0, w = b + W p >= 0, p w = 0 over the contacts, as an impulse
+// (w_c / W_cc), and the scale it is measured against (the largest impulse or |b_c| / W_cc).
+std::pair<double, double> violation(const NormalSystem& sys, const Eigen::VectorXd& d,
+                                    const Eigen::VectorXd& p) {
+  const Eigen::VectorXd w = sys.b + sys.W * p;
+  double worst = 0, scale = 0;
+  for (Eigen::Index c = 0; c < p.size(); ++c) {
+    const double wc = w[c] / d[c];
+    worst = std::max({worst, -p[c], -wc, std::min(std::max(p[c], 0.0), std::max(wc, 0.0))});
+    scale = std::max({scale, std::abs(p[c]), std::abs(sys.b[c]) / d[c]});
+  }
+  return {worst, scale};
+}
+
+}  // namespace
+
+template <int Dim>
+GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
+  GsResult result;
+  const bool frictionless = std::all_of(problem.contacts.begin(), problem.contacts.end(),
+                                        [](const Contact<Dim>& c) { return c.friction == 0.0; });
+  if (frictionless && !problem.contacts.empty()) {
+    const NormalSystem sys = normal_system(problem);
+    const auto m = sys.b.size();
+    const Eigen::VectorXd d = sys.W.diagonal();
+    // Proximal point (Rockafellar 1976): p_{k+1} solves the complementarity problem of
+    // min 1/2 p.W p + b.p + delta/2 |p - p_k|^2, i.e. the matrix W + delta I and the vector
+    // b - delta p_k, whose condition number is at most max W_cc / delta however redundant the
+    // contacts; its solutions converge to one of the original problem. From a warm start near
+    // the answer (the Newton iterations and steps of a quasi-static run) one step suffices.
+    // delta starts at 1e-12 of the largest W_cc, so that the proximal steps converge fast, and
+    // grows 100-fold (to 1e-6) whenever the pivoting cycles on an ill-conditioned W_AA.
+    const double w_max = d.maxCoeff();
+    double delta = 1e-12 * w_max;
+    ShiftedSolver solver(sys, delta);
+    Eigen::VectorXd p = sys.p.cwiseMax(0.0), q, w, next(m);
+    std::vector<char> active(static_cast<std::size_t>(m));
+    std::vector<std::int32_t> idx, infeasible;
+    bool solved = false;
+    double last = std::numeric_limits<double>::infinity();
+    for (int outer = 0; outer < kMaxProximalSteps && !solved; ++outer) {
+      q = sys.b - delta * p;
+      // The starting active set: the contacts whose local solution (the others' impulses fixed)
+      // has a positive impulse, p_c - w_c / M_cc > 0 (the semismooth-Newton rule).
+      w = q + sys.W * p + delta * p;
+      for (Eigen::Index c = 0; c < m; ++c) active[c] = p[c] - w[c] / (d[c] + delta) > 0.0;
+      // Block principal pivoting (Judice & Pires 1994): flip every infeasible contact while
+      // their number falls (three more tries when it does not), then one at a time, the last one
+      // (Murty 1974), which terminates for a positive-definite matrix.
+      std::size_t best = std::numeric_limits<std::size_t>::max();
+      int tries = 3;
+      bool pivoted = false;
+      for (int k = 0; k < kMaxPivots; ++k) {
+        idx.clear();
+        for (Eigen::Index c = 0; c < m; ++c)
+          if (active[c]) idx.push_back(static_cast<std::int32_t>(c));
+        ++result.pivots;
+        if (!solver.solve(idx, q, next)) break;
+        w = q + sys.W * next + delta * next;
+        double scale = next.cwiseAbs().maxCoeff();
+        for (Eigen::Index c = 0; c < m; ++c) scale = std::max(scale, std::abs(q[c]) / d[c]);
+        const double tol = 1e-12 * scale;
+        infeasible.clear();
+        for (Eigen::Index c = 0; c < m; ++c)
+          if (active[c] ? next[c] < -tol : w[c] / (d[c] + delta) < -tol)
+            infeasible.push_back(static_cast<std::int32_t>(c));
+        if (infeasible.empty()) {
+          pivoted = true;
+          break;
+        }
+        if (infeasible.size() < best) {
+          best = infeasible.size();
+          tries = 3;
+        } else if (tries > 0) {
+          --tries;
+        } else {
+          infeasible.erase(infeasible.begin(), infeasible.end() - 1);
+        }
+        for (const std::int32_t c : infeasible) active[c] = !active[c];
+      }
+      if (!pivoted) {
+        if (delta >= 1e-6 * w_max) break;
+        delta *= 100;
+        solver.set_shift(delta);
+        last = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      p = next.cwiseMax(0.0);
+      // Done when the violation meets the tolerance or stops falling (round-off, about 1e-14 of
+      // the impulses): Gauss-Seidel's error then decides, and sweeps if it must.
+      const auto [worst, scale] = violation(sys, d, p);
+      solved = worst <= 1e-3 * settings.tolerance * scale || worst > 0.5 * last;
+      last = worst;
+    }
+    if (solved)
+      for (Eigen::Index c = 0; c < m; ++c) {
+        Contact<Dim>& k = problem.contacts[static_cast<std::size_t>(c)];
+        k.impulse = p[c] * k.normal;
+      }
+  }
+  const GsResult gs = solve_gauss_seidel(problem, settings);
+  result.sweeps = gs.sweeps;
+  result.error = gs.error;
+  result.converged = gs.converged;
+  return result;
+}
+
+#define MPMCD_INSTANTIATE(D)                                 \
+  template NormalSystem normal_system<D>(const Problem<D>&); \
+  template GsResult solve_active_set<D>(Problem<D>&, const GsSettings&);
+MPMCD_INSTANTIATE(2)
+MPMCD_INSTANTIATE(3)
+#undef MPMCD_INSTANTIATE
+
+}  // namespace mpmcd::contact
