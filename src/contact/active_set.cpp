@@ -1,5 +1,7 @@
 #include "mpmcd/contact/active_set.hpp"
 
+#include "mpmcd/core/timer.hpp"
+
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
@@ -43,9 +45,16 @@ NormalSystem normal_system(const Problem<Dim>& p) {
     by_resource[resource(k.b)].push_back({static_cast<std::int32_t>(c), k.b, 1.0});
     if (k.a >= 0) by_resource[resource(k.a)].push_back({static_cast<std::int32_t>(c), k.a, -1.0});
   }
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (std::size_t r = 0; r < by_resource.size(); ++r) {
+  // Each resource's entries on the threads, concatenated in resource order (the same matrix for
+  // any thread count).
+  const auto nres = static_cast<std::int64_t>(by_resource.size());
+  std::vector<std::vector<Eigen::Triplet<double>>> part(by_resource.size());
+#pragma omp parallel for schedule(dynamic, 4) if (ng > 1)
+  for (std::int64_t ri = 0; ri < nres; ++ri) {
+    const auto r = static_cast<std::size_t>(ri);
     const auto& list = by_resource[r];
+    auto& out = part[r];
+    out.reserve(list.size() * list.size());
     for (const Entry& e : list) {
       const Vec<Dim>& ne = p.contacts[e.contact].normal;
       for (const Entry& f : list) {
@@ -59,10 +68,15 @@ NormalSystem normal_system(const Problem<Dim>& p) {
               G.template block<Dim, Dim>(Dim * p.slots[e.slot].local, Dim * p.slots[f.slot].local) *
               nf);
         }
-        triplets.emplace_back(e.contact, f.contact, e.sign * f.sign * v);
+        out.emplace_back(e.contact, f.contact, e.sign * f.sign * v);
       }
     }
   }
+  std::size_t total = 0;
+  for (const auto& t : part) total += t.size();
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(total);
+  for (const auto& t : part) triplets.insert(triplets.end(), t.begin(), t.end());
   sys.W.resize(m, m);
   sys.W.setFromTriplets(triplets.begin(), triplets.end());
   return sys;
@@ -149,7 +163,10 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
   const bool frictionless = std::all_of(problem.contacts.begin(), problem.contacts.end(),
                                         [](const Contact<Dim>& c) { return c.friction == 0.0; });
   if (frictionless && !problem.contacts.empty()) {
+    ScopedStage assemble(settings.timers, "contact.as.assemble");
     const NormalSystem sys = normal_system(problem);
+    assemble.done();
+    ScopedStage pivoting(settings.timers, "contact.as.pivot");
     const auto m = sys.b.size();
     const Eigen::VectorXd d = sys.W.diagonal();
     // Proximal point (Rockafellar 1976): p_{k+1} solves the complementarity problem of
@@ -221,13 +238,16 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
       solved = worst <= 1e-3 * settings.tolerance * scale || worst > 0.5 * last;
       last = worst;
     }
+    pivoting.done();
     if (solved)
       for (Eigen::Index c = 0; c < m; ++c) {
         Contact<Dim>& k = problem.contacts[static_cast<std::size_t>(c)];
         k.impulse = p[c] * k.normal;
       }
   }
+  ScopedStage polish(settings.timers, "contact.as.check");
   const GsResult gs = solve_gauss_seidel(problem, settings);
+  polish.done();
   result.sweeps = gs.sweeps;
   result.error = gs.error;
   result.converged = gs.converged;
