@@ -14,7 +14,13 @@ namespace {
 // Proximal steps of one solve before it is left to Gauss-Seidel.
 constexpr int kMaxProximalSteps = 30;
 // Block pivots of one proximal step before the shift grows (cycling on an ill-conditioned W_AA).
-constexpr int kMaxPivots = 30;
+constexpr int kMaxPivots = 100;
+// Gauss-Seidel sweeps before the pivoting: they finish the easy problems (a warm start that is
+// nearly right) without assembling W, and give the others a first active set close to the
+// answer, from which block pivoting needs a few pivots instead of dozens of single ones (on 51
+// problems of the 40-disk compaction at d/16 that Gauss-Seidel needed 380 to 2,900 sweeps for:
+// 4 to 45 pivots, no sweep after, 36x less time than Gauss-Seidel).
+constexpr int kPreSweeps = 10;
 }  // namespace
 
 template <int Dim>
@@ -163,6 +169,19 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
   const bool frictionless = std::all_of(problem.contacts.begin(), problem.contacts.end(),
                                         [](const Contact<Dim>& c) { return c.friction == 0.0; });
   if (frictionless && !problem.contacts.empty()) {
+    // The sweeps' answer is kept only if it meets 1e-3 of the tolerance (a warm start that was
+    // right): an answer just within the tolerance would leave the staggering impulse changes of
+    // the tolerance's order that the pivoting's exact answer does not.
+    GsSettings pre = settings;
+    pre.max_sweeps = std::min(kPreSweeps, settings.max_sweeps);
+    pre.tolerance = 1e-3 * settings.tolerance;
+    const GsResult first = solve_gauss_seidel(problem, pre);
+    result.sweeps = first.sweeps;
+    if (first.converged) {
+      result.error = first.error;
+      result.converged = true;
+      return result;
+    }
     ScopedStage assemble(settings.timers, "contact.as.assemble");
     const NormalSystem sys = normal_system(problem);
     assemble.done();
@@ -248,7 +267,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
   ScopedStage polish(settings.timers, "contact.as.check");
   const GsResult gs = solve_gauss_seidel(problem, settings);
   polish.done();
-  result.sweeps = gs.sweeps;
+  result.sweeps += gs.sweeps;
   result.error = gs.error;
   result.converged = gs.converged;
   return result;

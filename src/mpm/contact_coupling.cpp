@@ -243,7 +243,8 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     for (const auto& w : work_) old_nodal.push_back(w->P);
   contact::GsResult r;
   // Debugging (docs/contact.md): MPMCD_WRITE_STALLED_PROBLEM=<folder> writes each problem whose
-  // Gauss-Seidel does not converge, as given (warm start), for contact::read_problem.
+  // solve does not converge or takes more than 100 Gauss-Seidel sweeps, as given (warm start),
+  // for contact::read_problem.
   static const char* const stalled_dir = std::getenv("MPMCD_WRITE_STALLED_PROBLEM");
   contact::Problem<Dim> given;
   if (stalled_dir) given = problem_;
@@ -258,7 +259,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     r = settings_.contact.active_set ? contact::solve_active_set(problem_, gs)
                                      : contact::solve_gauss_seidel(problem_, gs);
   }
-  if (stalled_dir && !r.converged) {
+  if (stalled_dir && (!r.converged || r.sweeps > 100)) {
     static int written = 0;
     contact::write_problem(given, fmt::format("{}/stalled_{:04d}.txt", stalled_dir, written++));
   }

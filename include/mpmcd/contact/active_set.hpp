@@ -26,11 +26,12 @@ struct NormalSystem {
 template <int Dim>
 NormalSystem normal_system(const Problem<Dim>& problem);
 
-/// Solves a problem whose contacts are all frictionless by block principal pivoting (above),
-/// starting from the active set of the impulses in `problem`, then checks error(problem) and, if
-/// it is above settings.tolerance, continues with Gauss-Seidel sweeps (settings.max_sweeps). A
-/// problem with a frictional contact goes to Gauss-Seidel directly. GsResult::pivots counts the
-/// pivoting steps, GsResult::sweeps the Gauss-Seidel sweeps.
+/// Solves a problem whose contacts are all frictionless: up to 10 Gauss-Seidel sweeps from the
+/// impulses in `problem` (enough when they are nearly right), then block principal pivoting
+/// (above) from the active set they reach, then checks error(problem) and, if it is above
+/// settings.tolerance, continues with Gauss-Seidel sweeps (settings.max_sweeps). A problem with
+/// a frictional contact goes to Gauss-Seidel directly. GsResult::pivots counts the pivoting
+/// steps, GsResult::sweeps all Gauss-Seidel sweeps.
 template <int Dim>
 GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings);
 

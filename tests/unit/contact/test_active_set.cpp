@@ -112,7 +112,11 @@ TEST(ActiveSet, SolvesWhatGaussSeidelSolvesInFewPivots) {
     const auto rg = contact::solve_gauss_seidel(sweeps, s);
     ASSERT_TRUE(rd.converged);
     ASSERT_TRUE(rg.converged);
-    EXPECT_EQ(rd.sweeps, 0) << "the pivoting alone meets the tolerance";
+    // Gauss-Seidel alone needs 58 to 120 sweeps here: the solver's 10 sweeps do not suffice,
+    // the pivoting does, and no sweep follows it.
+    EXPECT_GT(rg.sweeps, 10);
+    EXPECT_EQ(rd.sweeps, 10);
+    EXPECT_GE(rd.pivots, 1);
     EXPECT_LE(rd.pivots, 10);
     EXPECT_LT(complementarity_violation(direct), 1e-10);
     // A positive-definite W: one solution, the same impulses.
@@ -123,9 +127,9 @@ TEST(ActiveSet, SolvesWhatGaussSeidelSolvesInFewPivots) {
   }
 }
 
-TEST(ActiveSet, RedundantContactsCostNoSweep) {
+TEST(ActiveSet, RedundantContactsNeedNoSweepAfterThePivoting) {
   // Doubled contacts: W singular, the impulses not unique; the velocities are. Block pivoting
-  // with the shifted, refined factorisation meets the tolerance without a sweep.
+  // with the shifted factorisation meets the tolerance without a sweep after its 10 first ones.
   auto direct = two_grain_problem(20, 3, 7);
   auto sweeps = direct;
   contact::GsSettings s;
@@ -134,7 +138,8 @@ TEST(ActiveSet, RedundantContactsCostNoSweep) {
   const auto rd = contact::solve_active_set(direct, s);
   const auto rg = contact::solve_gauss_seidel(sweeps, s);
   ASSERT_TRUE(rd.converged);
-  EXPECT_EQ(rd.sweeps, 0);
+  EXPECT_EQ(rd.sweeps, 10);
+  EXPECT_GE(rd.pivots, 1);
   EXPECT_LT(complementarity_violation(direct), 1e-10);
   // Same slot velocities as Gauss-Seidel where it converged.
   if (rg.converged) {
