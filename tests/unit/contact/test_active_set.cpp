@@ -73,6 +73,21 @@ double complementarity_violation(const contact::Problem<2>& p) {
   return worst / scale;
 }
 
+// The problem solved by both solvers to 1e-12.
+struct BothSolved {
+  contact::Problem<2> direct, sweeps;  // solved by solve_active_set, by solve_gauss_seidel
+  contact::GsResult rd, rg;            // their outcomes
+};
+BothSolved solve_both(const contact::Problem<2>& p) {
+  BothSolved b{p, p, {}, {}};
+  contact::GsSettings s;
+  s.tolerance = 1e-12;
+  s.max_sweeps = 100000;
+  b.rd = contact::solve_active_set(b.direct, s);
+  b.rg = contact::solve_gauss_seidel(b.sweeps, s);
+  return b;
+}
+
 }  // namespace
 
 TEST(ActiveSet, NormalSystemGivesTheGaussSeidelVelocities) {
@@ -103,13 +118,7 @@ TEST(ActiveSet, NormalSystemGivesTheGaussSeidelVelocities) {
 
 TEST(ActiveSet, SolvesWhatGaussSeidelSolvesInFewPivots) {
   for (unsigned seed : {1u, 2u, 3u}) {
-    auto direct = two_grain_problem(20, 0, seed);
-    auto sweeps = direct;
-    contact::GsSettings s;
-    s.tolerance = 1e-12;
-    s.max_sweeps = 100000;
-    const auto rd = contact::solve_active_set(direct, s);
-    const auto rg = contact::solve_gauss_seidel(sweeps, s);
+    const auto [direct, sweeps, rd, rg] = solve_both(two_grain_problem(20, 0, seed));
     ASSERT_TRUE(rd.converged);
     ASSERT_TRUE(rg.converged);
     // Gauss-Seidel alone needs 58 to 120 sweeps here: the solver's 10 sweeps do not suffice,
@@ -130,13 +139,7 @@ TEST(ActiveSet, SolvesWhatGaussSeidelSolvesInFewPivots) {
 TEST(ActiveSet, RedundantContactsNeedNoSweepAfterThePivoting) {
   // Doubled contacts: W singular, the impulses not unique; the velocities are. Block pivoting
   // with the shifted factorisation meets the tolerance without a sweep after its 10 first ones.
-  auto direct = two_grain_problem(20, 3, 7);
-  auto sweeps = direct;
-  contact::GsSettings s;
-  s.tolerance = 1e-12;
-  s.max_sweeps = 100000;
-  const auto rd = contact::solve_active_set(direct, s);
-  const auto rg = contact::solve_gauss_seidel(sweeps, s);
+  const auto [direct, sweeps, rd, rg] = solve_both(two_grain_problem(20, 3, 7));
   ASSERT_TRUE(rd.converged);
   EXPECT_EQ(rd.sweeps, 10);
   EXPECT_GE(rd.pivots, 1);
