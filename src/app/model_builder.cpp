@@ -313,22 +313,17 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
     c.walls.push_back({w.name, vec2(w.point), vec2(w.normal), vec2(w.velocity), w.friction});
   // The active-set solver solves the normal impulses only: refuse friction rather than drop it.
   if (c.active_set) {
-    if (cfg.contact.friction != 0.0)
-      throw InputError(cfg.source_path, 0, "contact.solver",
-                       "solver = \"active_set\" solves frictionless contacts only, but "
-                       "contact.friction is not 0: use solver = \"gauss_seidel\"");
+    const auto refuse = [&](std::int64_t line, const std::string& where) {
+      throw InputError(cfg.source_path, line, "contact.solver",
+                       fmt::format("solver = \"active_set\" solves frictionless contacts only, "
+                                   "but {} has friction: use solver = \"gauss_seidel\"",
+                                   where));
+    };
+    if (cfg.contact.friction != 0.0) refuse(0, "the default grain pair (contact.friction)");
     for (const auto& p : cfg.contact.pairs)
-      if (p.friction != 0.0)
-        throw InputError(cfg.source_path, p.line, "contact.solver",
-                         "solver = \"active_set\" solves frictionless contacts only, but a "
-                         "[[contact.pairs]] friction is not 0: use solver = \"gauss_seidel\"");
+      if (p.friction != 0.0) refuse(p.line, "a [[contact.pairs]] entry");
     for (const auto& w : cfg.walls)
-      if (w.friction != 0.0)
-        throw InputError(cfg.source_path, w.line, "contact.solver",
-                         fmt::format("solver = \"active_set\" solves frictionless contacts only, "
-                                     "but wall \"{}\" has friction: use solver = "
-                                     "\"gauss_seidel\"",
-                                     w.name));
+      if (w.friction != 0.0) refuse(w.line, fmt::format("wall \"{}\"", w.name));
   }
   return s;
 }

@@ -125,7 +125,6 @@ class ShiftedSolver {
       ldlt_.compute(Waa_);
       if (ldlt_.info() != Eigen::Success) return false;
       factored_ = active;
-      ++factorisations;
     }
     Eigen::VectorXd rhs(na);
     for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -q[active[i]];
@@ -136,8 +135,6 @@ class ShiftedSolver {
     for (Eigen::Index i = 0; i < na; ++i) p[active[i]] = x[i];
     return true;
   }
-
-  int factorisations = 0;  ///< LDL^T factorisations done [-]
 
  private:
   const NormalSystem& sys_;

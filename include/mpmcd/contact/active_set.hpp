@@ -8,7 +8,7 @@
 /// (Judice & Pires 1994, with Murty's single-pivot rule as the finite fallback) with a sparse
 /// LDL^T of W on the active set. Unlike Gauss-Seidel its cost does not grow with the
 /// conditioning of W: nearly redundant contacts (two grains' faces on one interface) cost nothing
-/// more. Redundant ones (W_AA singular) get a shifted factorisation refined to a solution.
+/// more. Redundant ones (W_AA singular) are solved through proximal steps on W + delta I.
 #include <Eigen/SparseCore>
 
 #include "mpmcd/contact/problem.hpp"
