@@ -24,7 +24,7 @@ constexpr int kPreSweeps = 10;
 }  // namespace
 
 template <int Dim>
-NormalSystem normal_system(const Problem<Dim>& p) {
+NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
   const auto m = static_cast<Eigen::Index>(p.contacts.size());
   NormalSystem sys;
   sys.b.resize(m);
@@ -48,9 +48,11 @@ NormalSystem normal_system(const Problem<Dim>& p) {
     const Vec<Dim> va = k.a >= 0 ? p.slots[k.a].v_free : k.wall_velocity;
     sys.b[c] = k.normal.dot(p.slots[k.b].v_free - va) + k.gap / p.dt;
     sys.p[c] = k.impulse.dot(k.normal);
+    if (!with_matrix) continue;
     by_resource[resource(k.b)].push_back({static_cast<std::int32_t>(c), k.b, 1.0});
     if (k.a >= 0) by_resource[resource(k.a)].push_back({static_cast<std::int32_t>(c), k.a, -1.0});
   }
+  if (!with_matrix) return sys;
   // Each resource's entries on the threads, concatenated in resource order (the same matrix for
   // any thread count).
   const auto nres = static_cast<std::int64_t>(by_resource.size());
@@ -90,16 +92,20 @@ NormalSystem normal_system(const Problem<Dim>& p) {
 
 namespace {
 
-// Factorisations of W_AA + delta I (sparse LDL^T), the last one kept: the proximal steps of one
-// solve (and the pivots that return to a set) reuse it while the active set is the same.
+// Factorisations of W_AA + delta I (sparse LDL^T) in a ShiftedFactor that keeps the last one:
+// the proximal steps of one solve, the pivots that return to a set and (with a cache) the next
+// solve of the same W reuse it while the active set and the shift are the same.
 class ShiftedSolver {
  public:
-  ShiftedSolver(const NormalSystem& sys, double delta) : sys_(sys), delta_(delta) {}
+  ShiftedSolver(const Eigen::SparseMatrix<double>& W, ShiftedFactor& f, double delta)
+      : W_(W), f_(f) {
+    set_shift(delta);
+  }
 
-  // A new shift delta [s/kg]; the next solve factorises.
+  // A new shift delta [s/kg]; the next solve factorises unless it is the factorised one.
   void set_shift(double delta) {
-    delta_ = delta;
-    factored_.clear();
+    if (delta != f_.delta) f_.active.clear();
+    f_.delta = delta;
   }
 
   // p_A = (W_AA + delta I)^-1 r_A with r = -q on the contacts `active`, 0 elsewhere; false
@@ -109,46 +115,43 @@ class ShiftedSolver {
     const auto na = static_cast<Eigen::Index>(active.size());
     p.setZero();
     if (na == 0) return true;
-    if (active != factored_) {
-      factored_.clear();
-      std::vector<std::int32_t> where(static_cast<std::size_t>(sys_.W.rows()), -1);
+    if (active != f_.active) {
+      f_.active.clear();
+      std::vector<std::int32_t> where(static_cast<std::size_t>(W_.rows()), -1);
       for (Eigen::Index i = 0; i < na; ++i) where[static_cast<std::size_t>(active[i])] = i;
       std::vector<Eigen::Triplet<double>> t;
       for (Eigen::Index i = 0; i < na; ++i)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(sys_.W, active[i]); it; ++it) {
+        for (Eigen::SparseMatrix<double>::InnerIterator it(W_, active[i]); it; ++it) {
           const std::int32_t j = where[static_cast<std::size_t>(it.row())];
           if (j >= 0) t.emplace_back(j, i, it.value());
         }
-      Waa_.resize(na, na);
-      Waa_.setFromTriplets(t.begin(), t.end());
-      ldlt_.setShift(delta_);
-      ldlt_.compute(Waa_);
-      if (ldlt_.info() != Eigen::Success) return false;
-      factored_ = active;
+      f_.Waa.resize(na, na);
+      f_.Waa.setFromTriplets(t.begin(), t.end());
+      f_.ldlt.setShift(f_.delta);
+      f_.ldlt.compute(f_.Waa);
+      if (f_.ldlt.info() != Eigen::Success) return false;
+      f_.active = active;
     }
     Eigen::VectorXd rhs(na);
     for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -q[active[i]];
-    Eigen::VectorXd x = ldlt_.solve(rhs);
+    Eigen::VectorXd x = f_.ldlt.solve(rhs);
     // One step of iterative refinement against the shifted matrix.
-    x += ldlt_.solve(rhs - Waa_ * x - delta_ * x);
+    x += f_.ldlt.solve(rhs - f_.Waa * x - f_.delta * x);
     if (!x.allFinite()) return false;
     for (Eigen::Index i = 0; i < na; ++i) p[active[i]] = x[i];
     return true;
   }
 
  private:
-  const NormalSystem& sys_;
-  double delta_;
-  std::vector<std::int32_t> factored_;
-  Eigen::SparseMatrix<double> Waa_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+  const Eigen::SparseMatrix<double>& W_;
+  ShiftedFactor& f_;
 };
 
 // The largest violation of p >= 0, w = b + W p >= 0, p w = 0 over the contacts, as an impulse
 // (w_c / W_cc), and the scale it is measured against (the largest impulse or |b_c| / W_cc).
-std::pair<double, double> violation(const NormalSystem& sys, const Eigen::VectorXd& d,
-                                    const Eigen::VectorXd& p) {
-  const Eigen::VectorXd w = sys.b + sys.W * p;
+std::pair<double, double> violation(const NormalSystem& sys, const Eigen::SparseMatrix<double>& W,
+                                    const Eigen::VectorXd& d, const Eigen::VectorXd& p) {
+  const Eigen::VectorXd w = sys.b + W * p;
   double worst = 0, scale = 0;
   for (Eigen::Index c = 0; c < p.size(); ++c) {
     const double wc = w[c] / d[c];
@@ -161,7 +164,8 @@ std::pair<double, double> violation(const NormalSystem& sys, const Eigen::Vector
 }  // namespace
 
 template <int Dim>
-GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
+GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
+                          ActiveSetCache* cache) {
   GsResult result;
   const bool frictionless = std::all_of(problem.contacts.begin(), problem.contacts.end(),
                                         [](const Contact<Dim>& c) { return c.friction == 0.0; });
@@ -180,11 +184,20 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
       return result;
     }
     ScopedStage assemble(settings.timers, "contact.as.assemble");
-    const NormalSystem sys = normal_system(problem);
+    const bool reuse = cache && cache->valid;
+    NormalSystem sys = normal_system(problem, !reuse);
+    ActiveSetCache local;
+    ActiveSetCache& kept = cache ? *cache : local;
+    if (!reuse) {
+      kept.W = std::move(sys.W);
+      kept.factor.active.clear();
+      kept.valid = true;
+    }
+    const Eigen::SparseMatrix<double>& W = kept.W;
     assemble.done();
     ScopedStage pivoting(settings.timers, "contact.as.pivot");
     const auto m = sys.b.size();
-    const Eigen::VectorXd d = sys.W.diagonal();
+    const Eigen::VectorXd d = W.diagonal();
     // Proximal point (Rockafellar 1976): p_{k+1} solves the complementarity problem of
     // min 1/2 p.W p + b.p + delta/2 |p - p_k|^2, i.e. the matrix W + delta I and the vector
     // b - delta p_k, whose condition number is at most max W_cc / delta however redundant the
@@ -194,7 +207,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
     // grows 100-fold (to 1e-6) whenever the pivoting cycles on an ill-conditioned W_AA.
     const double w_max = d.maxCoeff();
     double delta = 1e-12 * w_max;
-    ShiftedSolver solver(sys, delta);
+    ShiftedSolver solver(W, kept.factor, delta);
     Eigen::VectorXd p = sys.p.cwiseMax(0.0), q, w, next(m);
     std::vector<char> active(static_cast<std::size_t>(m));
     std::vector<std::int32_t> idx, infeasible;
@@ -204,7 +217,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
       q = sys.b - delta * p;
       // The starting active set: the contacts whose local solution (the others' impulses fixed)
       // has a positive impulse, p_c - w_c / M_cc > 0 (the semismooth-Newton rule).
-      w = q + sys.W * p + delta * p;
+      w = q + W * p + delta * p;
       for (Eigen::Index c = 0; c < m; ++c) active[c] = p[c] - w[c] / (d[c] + delta) > 0.0;
       // Block principal pivoting (Judice & Pires 1994): flip every infeasible contact while
       // their number falls (three more tries when it does not), then one at a time, the last one
@@ -218,7 +231,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
           if (active[c]) idx.push_back(static_cast<std::int32_t>(c));
         ++result.pivots;
         if (!solver.solve(idx, q, next)) break;
-        w = q + sys.W * next + delta * next;
+        w = q + W * next + delta * next;
         double scale = next.cwiseAbs().maxCoeff();
         for (Eigen::Index c = 0; c < m; ++c) scale = std::max(scale, std::abs(q[c]) / d[c]);
         const double tol = 1e-12 * scale;
@@ -250,7 +263,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
       p = next.cwiseMax(0.0);
       // Done when the violation meets the tolerance or stops falling (round-off, about 1e-14 of
       // the impulses): Gauss-Seidel's error then decides, and sweeps if it must.
-      const auto [worst, scale] = violation(sys, d, p);
+      const auto [worst, scale] = violation(sys, W, d, p);
       solved = worst <= 1e-3 * settings.tolerance * scale || worst > 0.5 * last;
       last = worst;
     }
@@ -270,9 +283,9 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings) {
   return result;
 }
 
-#define MPMCD_INSTANTIATE(D)                                 \
-  template NormalSystem normal_system<D>(const Problem<D>&); \
-  template GsResult solve_active_set<D>(Problem<D>&, const GsSettings&);
+#define MPMCD_INSTANTIATE(D)                                       \
+  template NormalSystem normal_system<D>(const Problem<D>&, bool); \
+  template GsResult solve_active_set<D>(Problem<D>&, const GsSettings&, ActiveSetCache*);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)
 #undef MPMCD_INSTANTIATE

@@ -129,15 +129,15 @@ void forward_substitute(Work& w) {
 }  // namespace
 
 template <int Dim>
-void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
+bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   // Z = A^-1 E (response of the grain's velocities to unit impulses at its slots; A^-1 -> M^-1
   // for a lumped group) and its slot rows G = E^T Z, from the factorisation of the current Newton
   // matrix. Column (j, d) of E is sum_k w_jk e_{a_jk, d} (one node of weight 1 for a node slot).
   GrainWork& w = *work_[g];
   if (!w.lumped_group) {
-    if (!reuse_factor(w, settings_) && !grain_factor(g, dt_)) return;
+    if (!reuse_factor(w, settings_) && !grain_factor(g, dt_)) return true;
     // Z and G depend only on the factorisation and the slots (fixed within a step).
-    if (w.z_factor == w.factor_count) return;
+    if (w.z_factor == w.factor_count) return false;
     w.z_factor = w.factor_count;
   }
   const auto k = static_cast<Eigen::Index>(w.slots.size());
@@ -162,7 +162,7 @@ void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   if (w.z_forward) {
     forward_substitute(w);
     G.noalias() = w.Z.transpose() * w.ldlt.vectorD().cwiseInverse().asDiagonal() * w.Z;
-    return;
+    return true;
   }
   if (!w.lumped_group)
     for (Eigen::Index c = 0; c < Dim * k; ++c)
@@ -175,17 +175,22 @@ void ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
     for (std::int32_t q = slot_start_[s] + 1; q < slot_start_[s + 1]; ++q)
       G.middleRows(Dim * i, Dim) += slot_weight_[q] * w.Z.middleRows(slot_node_[q] * Dim, Dim);
   }
+  return true;
 }
 
 template <int Dim>
 double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   // Response of each grain: its compliance group (exact, linearised) or the lumped 1/m_I.
   const auto ngroups = static_cast<std::int64_t>(problem_.groups.size());
+  bool new_compliance = false;
   ThreadedRegion threaded(&timers_, ngroups > 1);
-#pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1)
+#pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1) reduction(|| : new_compliance)
   for (std::int64_t gi = 0; gi < ngroups; ++gi)
-    grain_compliance(static_cast<std::size_t>(slot_ref_[problem_.groups[gi].slots[0]].first));
+    new_compliance =
+        grain_compliance(static_cast<std::size_t>(slot_ref_[problem_.groups[gi].slots[0]].first)) ||
+        new_compliance;
   threaded.done();
+  if (new_compliance) as_cache_.valid = false;
   for (const auto& w : work_)
     if (!w->failure.empty()) return 1.0;
   // Free velocities: the grains' current iterates without their contact impulses (method.md §4).
@@ -256,7 +261,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     }
     contact::GsSettings gs = gs_settings();
     gs.order = &sweep_order_;
-    r = settings_.contact.active_set ? contact::solve_active_set(problem_, gs)
+    r = settings_.contact.active_set ? contact::solve_active_set(problem_, gs, &as_cache_)
                                      : contact::solve_gauss_seidel(problem_, gs);
   }
   if (stalled_dir && (!r.converged || r.sweeps > 100)) {
@@ -338,7 +343,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   template std::vector<WarmImpulse<D>> ImplicitSolver<D>::gather_warm_start() const; \
   template Vec<D> ImplicitSolver<D>::slot_velocity(std::size_t) const;               \
   template void ImplicitSolver<D>::spread_slot_impulses();                           \
-  template void ImplicitSolver<D>::grain_compliance(std::size_t);                    \
+  template bool ImplicitSolver<D>::grain_compliance(std::size_t);                    \
   template double ImplicitSolver<D>::update_contacts(StepStats&);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)

@@ -43,6 +43,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   problem_.slots.clear();
   problem_.contacts.clear();
   sweep_order_ready_ = false;
+  as_cache_.valid = false;
   slot_ref_.clear();
   slot_next_.clear();
   slot_start_.assign(1, 0);
@@ -115,14 +116,17 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   // detection's time otherwise).
   if (cs.criterion == GapCriterion::kGap || cs.grain_faces) {
     point_reach_.resize(points_.x.size());
+    if (cs.grain_faces) point_dinv_.resize(points_.x.size());
     const auto nl = static_cast<std::int64_t>(local_.size());
 #pragma omp parallel for schedule(dynamic, 4) if (nl > 1)
     for (std::int64_t i = 0; i < nl; ++i) {
       const points::Grain& gr = grains_[local_[static_cast<std::size_t>(i)]];
       for (std::int64_t p = gr.begin; p < gr.end; ++p) {
+        const Mat<Dim> D = points_.F[p] * points_.domain[p];
         double r = 0;
-        for (int d = 0; d < Dim; ++d) r += (points_.F[p] * points_.domain[p].col(d)).norm();
+        for (int d = 0; d < Dim; ++d) r += D.col(d).norm();
         point_reach_[p] = r;
+        if (cs.grain_faces) point_dinv_[p] = D.inverse();
       }
     }
   }

@@ -179,28 +179,82 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
     }
     return k;
   };
-  // Each grain's points by the cell of their centre (sorted (cell, point)), made when needed.
-  std::vector<std::vector<std::pair<std::int64_t, std::int64_t>>> by_cell(grains_.size());
-  const auto index =
-      [&](std::int32_t g) -> const std::vector<std::pair<std::int64_t, std::int64_t>>& {
-    auto& v = by_cell[static_cast<std::size_t>(g)];
-    if (v.empty()) {
-      for (std::int64_t p = grains_[g].begin; p < grains_[g].end; ++p)
-        v.emplace_back(key_of(cell_of(points_.x[p])), p);
-      std::sort(v.begin(), v.end());
-    }
-    return v;
+  // Each grain's points by the cell of their centre: a table over the box of cells its centres
+  // occupy (offsets, then the points of each cell in ascending order), for the grains of the
+  // links, made on the threads before the search.
+  struct CellTable {
+    IVec<Dim> lo, n;                  // first cell and cell counts of the box
+    std::vector<std::int32_t> start;  // per box cell (x fastest): offset into pts
+    std::vector<std::int64_t> pts;    // the points, cell by cell
   };
-  // Calls f(q) for the points q of grain g whose centre is within r cells (per axis) of x's cell.
+  std::vector<CellTable> by_cell(grains_.size());
+  {
+    std::vector<std::int32_t> involved;
+    for (const auto& l : links) {
+      involved.push_back(l[0]);
+      involved.push_back(l[1]);
+    }
+    std::sort(involved.begin(), involved.end());
+    involved.erase(std::unique(involved.begin(), involved.end()), involved.end());
+    const auto ni = static_cast<std::int64_t>(involved.size());
+    const ThreadedRegion threaded(&timers_, ni > 1);
+#pragma omp parallel for schedule(dynamic, 1) if (ni > 1)
+    for (std::int64_t i = 0; i < ni; ++i) {
+      const std::int32_t g = involved[static_cast<std::size_t>(i)];
+      CellTable& t = by_cell[static_cast<std::size_t>(g)];
+      const std::int64_t b = grains_[g].begin, e = grains_[g].end;
+      std::vector<std::int64_t> box(static_cast<std::size_t>(e - b));
+      IVec<Dim> lo = IVec<Dim>::Constant(std::numeric_limits<std::int64_t>::max());
+      IVec<Dim> hi = IVec<Dim>::Constant(std::numeric_limits<std::int64_t>::min());
+      for (std::int64_t p = b; p < e; ++p) {
+        const IVec<Dim> c = cell_of(points_.x[p]);
+        lo = lo.cwiseMin(c);
+        hi = hi.cwiseMax(c);
+      }
+      t.lo = lo;
+      t.n = hi - lo + IVec<Dim>::Ones();
+      std::int64_t cells = 1;
+      for (int d = 0; d < Dim; ++d) cells *= t.n[d];
+      t.start.assign(static_cast<std::size_t>(cells) + 1, 0);
+      for (std::int64_t p = b; p < e; ++p) {
+        const IVec<Dim> c = cell_of(points_.x[p]) - lo;
+        std::int64_t k = 0, mul = 1;
+        for (int d = 0; d < Dim; ++d) {
+          k += c[d] * mul;
+          mul *= t.n[d];
+        }
+        box[static_cast<std::size_t>(p - b)] = k;
+        ++t.start[static_cast<std::size_t>(k) + 1];
+      }
+      for (std::size_t k = 0; k + 1 < t.start.size(); ++k) t.start[k + 1] += t.start[k];
+      t.pts.resize(static_cast<std::size_t>(e - b));
+      std::vector<std::int32_t> fill(t.start.begin(), t.start.end() - 1);
+      for (std::int64_t p = b; p < e; ++p)
+        t.pts[static_cast<std::size_t>(fill[static_cast<std::size_t>(box[p - b])]++)] = p;
+    }
+  }
+  // Calls f(q) for the points q of grain g whose centre is within r cells (per axis) of x's
+  // cell, cell by cell (x fastest) and in ascending order within a cell; cells outside the grid
+  // hold none.
   const auto near = [&](std::int32_t g, const Vec<Dim>& x, int r, auto&& f) {
-    const auto& v = index(g);
+    const CellTable& t = by_cell[static_cast<std::size_t>(g)];
     const IVec<Dim> c0 = cell_of(x);
     IVec<Dim> off = IVec<Dim>::Constant(-r);
     while (true) {
-      const std::int64_t k = key_of(c0 + off);
-      if (k >= 0) {
-        auto it = std::lower_bound(v.begin(), v.end(), std::make_pair(k, std::int64_t{-1}));
-        for (; it != v.end() && it->first == k; ++it) f(it->second);
+      const IVec<Dim> c = c0 + off;
+      if (key_of(c) >= 0) {
+        std::int64_t k = 0, mul = 1;
+        bool inside = true;
+        for (int d = 0; d < Dim && inside; ++d) {
+          const std::int64_t cd = c[d] - t.lo[d];
+          inside = cd >= 0 && cd < t.n[d];
+          k += cd * mul;
+          mul *= t.n[d];
+        }
+        if (inside)
+          for (std::int32_t j = t.start[static_cast<std::size_t>(k)];
+               j < t.start[static_cast<std::size_t>(k) + 1]; ++j)
+            f(t.pts[static_cast<std::size_t>(j)]);
       }
       int d = 0;
       while (d < Dim && off[d] == r) off[d++] = -r;
@@ -212,7 +266,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
   // +infinity when the ray misses it or the domain lies behind x [m].
   const auto entry = [&](std::int64_t q, const Vec<Dim>& x, const Vec<Dim>& nu) {
     constexpr double inf = std::numeric_limits<double>::infinity();
-    const Mat<Dim> Dq = (points_.F[q] * points_.domain[q]).inverse();
+    const Mat<Dim>& Dq = point_dinv_[q];
     const Vec<Dim> s0 = Dq * (x - points_.x[q]), ds = Dq * nu;
     double t_in = -inf, t_out = inf;
     for (int d = 0; d < Dim; ++d) {
@@ -227,80 +281,109 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
     }
     return t_in <= t_out && t_out > 0 ? t_in : inf;
   };
-  double items = 0;
-  std::vector<std::int64_t> zone;
-  std::vector<Vec<Dim>> xs(corners);
-  std::vector<std::int32_t> nodes_x, nodes_y;
-  std::vector<double> weights_x, weights_y;
-  // The contacts of grain X's boundary faces at the pair's shared nodes (links[i][col], i in
-  // [i0, i1), are X's active nodes there) against grain Y.
-  const auto faces_of = [&](std::int32_t X, std::int32_t Y, int col, std::size_t i0,
-                            std::size_t i1) {
-    const GrainWork& wx = *work_[X];
-    zone.clear();
-    for (std::size_t i = i0; i < i1; ++i)
-      for (std::int32_t k = wx.node_pts_start[links[i][col]];
-           k < wx.node_pts_start[links[i][col] + 1]; ++k)
-        zone.push_back(grains_[X].begin + wx.node_pts[k]);
-    std::sort(zone.begin(), zone.end());
-    zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
-    for (const std::int64_t p : zone) {
-      const Mat<Dim> D = points_.F[p] * points_.domain[p];
-      const Mat<Dim> Dinv = D.inverse();
-      for (int k = 0; k < Dim; ++k)
-        for (const int side : {0, 1}) {
-          // Face s_k = sign: outward normal sign D^-T e_k, at 1/|D^-T e_k| from the centre.
-          const double sign = side ? 1.0 : -1.0;
-          const Vec<Dim> m = Dinv.row(k).transpose();
-          const double len = m.norm();
-          const Vec<Dim> nu = sign * m / len;
-          const Vec<Dim> xf = points_.x[p] + sign * D.col(k);
-          items += 1;
-          // Interior face: another domain of X holds the point half a domain beyond it.
-          const Vec<Dim> xt = xf + 0.5 / len * nu;
-          bool interior = false;
-          near(X, xt, 1, [&](std::int64_t q) {
-            if (interior || q == p || (points_.x[q] - xt).norm() > point_reach_[q]) return;
-            const Mat<Dim> Dq = points_.F[q] * points_.domain[q];
-            interior = (Dq.inverse() * (xt - points_.x[q])).cwiseAbs().maxCoeff() <= 1.0;
-          });
-          if (interior) continue;
-          double gap = std::numeric_limits<double>::infinity();
-          near(Y, xf, 2, [&](std::int64_t q) {
-            if ((points_.x[q] - xf).norm() <= point_reach_[q] + range)
-              gap = std::min(gap, entry(q, xf, nu));
-          });
-          if (!(gap <= range)) continue;
-          for (int c = 0; c < corners; ++c) {
-            Vec<Dim> sc = Vec<Dim>::Zero();
-            sc[k] = sign;
-            for (int d = 0, bit = 0; d < Dim; ++d)
-              if (d != k) sc[d] = (c >> bit++) & 1 ? 1.0 : -1.0;
-            xs[static_cast<std::size_t>(c)] = points_.x[p] + D * sc;
-          }
-          if (!corner_weights(X, xs, 1.0, nodes_x, weights_x) ||
-              !corner_weights(Y, xs, 1.0, nodes_y, weights_y))
-            continue;
-          contact::Contact<Dim> c;
-          c.a = weighted_slot(X, nodes_x, weights_x);
-          c.b = weighted_slot(Y, nodes_y, weights_y);
-          // Warm-start key: -1 - the face's number (point, axis, side), stable from step to step.
-          slot_key_[c.b] = -1 - (p * 2 * Dim + 2 * k + side);
-          c.normal = nu;
-          c.gap = std::max(0.0, gap);
-          c.friction = cs.friction[grains_[X].material * cs.materials + grains_[Y].material];
-          c.impulse = warm_impulse(slot_key_[c.b], X, Y);
-          problem_.contacts.push_back(c);
-        }
-    }
+  // One face that makes a contact, found on the threads and turned into slots and a contact in
+  // the serial order afterwards.
+  struct Hit {
+    std::int64_t key;  // warm-start key: -1 - the face's number (point, axis, side)
+    Vec<Dim> normal;
+    double gap;
+    std::vector<std::int32_t> nodes_x, nodes_y;
+    std::vector<double> weights_x, weights_y;
   };
+  // The passes: grain X's boundary faces at the pair's shared nodes (links[i][col], i in
+  // [i0, i1), are X's active nodes there) against grain Y; each pair A < B gives (A, B) then
+  // (B, A).
+  struct Pass {
+    std::int32_t X, Y;
+    int col;
+    std::size_t i0, i1;
+  };
+  std::vector<Pass> passes;
   for (std::size_t i0 = 0; i0 < links.size();) {
     const std::int32_t A = links[i0][0], B = links[i0][1];
     std::size_t i1 = i0;
     while (i1 < links.size() && links[i1][0] == A && links[i1][1] == B) ++i1;
-    faces_of(A, B, 2, i0, i1);
-    faces_of(B, A, 3, i0, i1);
+    passes.push_back({A, B, 2, i0, i1});
+    passes.push_back({B, A, 3, i0, i1});
     i0 = i1;
+  }
+  std::vector<std::vector<Hit>> hits(passes.size());
+  double items = 0;
+  const auto npasses = static_cast<std::int64_t>(passes.size());
+  {
+    const ThreadedRegion threaded(&timers_, npasses > 1);
+#pragma omp parallel for schedule(dynamic, 1) if (npasses > 1) reduction(+ : items)
+    for (std::int64_t pi = 0; pi < npasses; ++pi) {
+      const Pass& ps = passes[static_cast<std::size_t>(pi)];
+      const std::int32_t X = ps.X, Y = ps.Y;
+      const GrainWork& wx = *work_[X];
+      std::vector<std::int64_t> zone;
+      for (std::size_t i = ps.i0; i < ps.i1; ++i)
+        for (std::int32_t k = wx.node_pts_start[links[i][ps.col]];
+             k < wx.node_pts_start[links[i][ps.col] + 1]; ++k)
+          zone.push_back(grains_[X].begin + wx.node_pts[k]);
+      std::sort(zone.begin(), zone.end());
+      zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+      std::vector<Vec<Dim>> xs(corners);
+      Hit hit;
+      for (const std::int64_t p : zone) {
+        const Mat<Dim> D = points_.F[p] * points_.domain[p];
+        const Mat<Dim>& Dinv = point_dinv_[p];
+        for (int k = 0; k < Dim; ++k)
+          for (const int side : {0, 1}) {
+            // Face s_k = sign: outward normal sign D^-T e_k, at 1/|D^-T e_k| from the centre.
+            const double sign = side ? 1.0 : -1.0;
+            const Vec<Dim> m = Dinv.row(k).transpose();
+            const double len = m.norm();
+            const Vec<Dim> nu = sign * m / len;
+            const Vec<Dim> xf = points_.x[p] + sign * D.col(k);
+            items += 1;
+            // Interior face: another domain of X holds the point half a domain beyond it.
+            const Vec<Dim> xt = xf + 0.5 / len * nu;
+            bool interior = false;
+            near(X, xt, 1, [&](std::int64_t q) {
+              if (interior || q == p || (points_.x[q] - xt).norm() > point_reach_[q]) return;
+              interior = (point_dinv_[q] * (xt - points_.x[q])).cwiseAbs().maxCoeff() <= 1.0;
+            });
+            if (interior) continue;
+            double gap = std::numeric_limits<double>::infinity();
+            near(Y, xf, 2, [&](std::int64_t q) {
+              if ((points_.x[q] - xf).norm() <= point_reach_[q] + range)
+                gap = std::min(gap, entry(q, xf, nu));
+            });
+            if (!(gap <= range)) continue;
+            for (int c = 0; c < corners; ++c) {
+              Vec<Dim> sc = Vec<Dim>::Zero();
+              sc[k] = sign;
+              for (int d = 0, bit = 0; d < Dim; ++d)
+                if (d != k) sc[d] = (c >> bit++) & 1 ? 1.0 : -1.0;
+              xs[static_cast<std::size_t>(c)] = points_.x[p] + D * sc;
+            }
+            if (!corner_weights(X, xs, 1.0, hit.nodes_x, hit.weights_x) ||
+                !corner_weights(Y, xs, 1.0, hit.nodes_y, hit.weights_y))
+              continue;
+            hit.key = -1 - (p * 2 * Dim + 2 * k + side);
+            hit.normal = nu;
+            hit.gap = std::max(0.0, gap);
+            hits[static_cast<std::size_t>(pi)].push_back(hit);
+          }
+      }
+    }
+  }
+  // The slots and contacts in the order of the passes (the same problem for any thread count).
+  for (std::size_t pi = 0; pi < passes.size(); ++pi) {
+    const std::int32_t X = passes[pi].X, Y = passes[pi].Y;
+    for (const Hit& hit : hits[pi]) {
+      contact::Contact<Dim> c;
+      c.a = weighted_slot(X, hit.nodes_x, hit.weights_x);
+      c.b = weighted_slot(Y, hit.nodes_y, hit.weights_y);
+      slot_key_[c.b] = hit.key;
+      c.normal = hit.normal;
+      c.gap = hit.gap;
+      c.friction = cs.friction[grains_[X].material * cs.materials + grains_[Y].material];
+      c.impulse = warm_impulse(hit.key, X, Y);
+      problem_.contacts.push_back(c);
+    }
   }
   return items;
 }

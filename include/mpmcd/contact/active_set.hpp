@@ -9,7 +9,10 @@
 /// LDL^T of W on the active set. Unlike Gauss-Seidel its cost does not grow with the
 /// conditioning of W: nearly redundant contacts (two grains' faces on one interface) cost nothing
 /// more. Redundant ones (W_AA singular) are solved through proximal steps on W + delta I.
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <cstdint>
+#include <vector>
 
 #include "mpmcd/contact/problem.hpp"
 
@@ -22,17 +25,38 @@ struct NormalSystem {
   Eigen::VectorXd p;              ///< normal impulses of the problem's contacts [N s]
 };
 
-/// The normal system of a problem (every contact's friction ignored).
+/// The normal system of a problem (every contact's friction ignored); without `with_matrix`,
+/// only b and p (W left empty).
 template <int Dim>
-NormalSystem normal_system(const Problem<Dim>& problem);
+NormalSystem normal_system(const Problem<Dim>& problem, bool with_matrix = true);
+
+/// A sparse LDL^T of W_AA + delta I for one active set A (the pivoting's linear solves).
+struct ShiftedFactor {
+  double delta = 0;                  ///< the shift delta [s/kg]
+  std::vector<std::int32_t> active;  ///< the contacts of A, ascending (empty: nothing factorised)
+  Eigen::SparseMatrix<double> Waa;   ///< W restricted to A [s/kg]
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  ///< LDL^T of Waa + delta I
+};
+
+/// What one solve leaves for the next solve of the same contacts with the same compliances (the
+/// Newton iterations of a step between two factorisations of a grain): W and the last
+/// factorisation, so that a solve whose active set has not changed assembles and factorises
+/// nothing. The caller clears `valid` whenever the contacts or a group's G change.
+struct ActiveSetCache {
+  bool valid = false;             ///< W and factor describe the problem's current W [-]
+  Eigen::SparseMatrix<double> W;  ///< the normal Delassus matrix [s/kg]
+  ShiftedFactor factor;           ///< the last factorisation of the pivoting
+};
 
 /// Solves a problem whose contacts are all frictionless: up to 10 Gauss-Seidel sweeps from the
 /// impulses in `problem` (enough when they are nearly right), then block principal pivoting
 /// (above) from the active set they reach, then checks error(problem) and, if it is above
 /// settings.tolerance, continues with Gauss-Seidel sweeps (settings.max_sweeps). A problem with
 /// a frictional contact goes to Gauss-Seidel directly. GsResult::pivots counts the pivoting
-/// steps, GsResult::sweeps all Gauss-Seidel sweeps.
+/// steps, GsResult::sweeps all Gauss-Seidel sweeps. With a `cache` that is valid, its W and
+/// factorisation are used instead of being made again; it is left valid with this solve's.
 template <int Dim>
-GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings);
+GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
+                          ActiveSetCache* cache = nullptr);
 
 }  // namespace mpmcd::contact

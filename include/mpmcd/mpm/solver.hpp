@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "mpmcd/contact/active_set.hpp"
 #include "mpmcd/contact/problem.hpp"
 #include "mpmcd/core/timer.hpp"
 #include "mpmcd/core/types.hpp"
@@ -141,7 +142,9 @@ class ImplicitSolver {
   // Grain g's Newton matrix, assembled (if stale) and factorised: prepare_factor with the solver's
   // points, law and the grain's contact compliance. False on a failed factorisation.
   bool grain_factor(std::size_t g, double dt);
-  void grain_compliance(std::size_t g);
+  // Grain g's compliance group G (and Z) from its current factorisation; true when G was
+  // recomputed (a new factorisation, or a lumped group).
+  bool grain_compliance(std::size_t g);
   void detect_contacts(double dt);
   double update_contacts(StepStats& stats);
   std::int32_t slot_of(std::int32_t g, std::int32_t a);
@@ -233,12 +236,17 @@ class ImplicitSolver {
   // solve and kept for the later Newton iterations (the same contacts and groups).
   contact::SweepOrder sweep_order_;
   bool sweep_order_ready_ = false;
+  // The active-set solver's W and factorisation, kept while this step's contacts and the grains'
+  // compliances stay the same (cleared at detection and when a G is recomputed).
+  contact::ActiveSetCache as_cache_;
   // Slots this rank serves to others and asks from others (links_) [-].
   std::pair<std::size_t, std::size_t> link_sizes() const;
   // Items of the last contact detection on this rank [-].
   double detect_items_ = 0;
   // Per point: sum_i |F r_i|, a bound of its domain's extent along any direction [m].
   std::vector<double> point_reach_;
+  // Per point, with face contacts between grains: (F D0)^-1, the inverse of its domain's map [1/m].
+  std::vector<Mat<Dim>> point_dinv_;
   double time_ = 0.0;
   double dt_ = 0.0;
   bool step_ready_ = false;

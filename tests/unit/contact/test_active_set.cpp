@@ -164,3 +164,46 @@ TEST(ActiveSet, FrictionGoesToGaussSeidel) {
   for (std::size_t c = 0; c < direct.contacts.size(); ++c)
     EXPECT_EQ(direct.contacts[c].impulse, sweeps.contacts[c].impulse);
 }
+
+TEST(ActiveSet, CachedMatrixAndFactorisationGiveTheSameImpulses) {
+  // The Newton iterations of a step solve the same contacts and compliances with new free
+  // velocities: a valid cache keeps W and the last factorisation of W_AA + delta I, and must
+  // give what a solve from scratch gives, bit for bit.
+  const auto base = two_grain_problem(20, 3, 11);
+  contact::GsSettings s;
+  s.tolerance = 1e-12;
+  s.max_sweeps = 100000;
+  contact::ActiveSetCache cache;
+  auto first = base;
+  const auto r1 = contact::solve_active_set(first, s, &cache);
+  ASSERT_TRUE(r1.converged);
+  ASSERT_TRUE(cache.valid);
+  ASSERT_GE(r1.pivots, 1);
+  const Eigen::SparseMatrix<double> W = cache.W;
+  // The next iterate: free velocities moved by 1e-3 of their size, warm start from the answer.
+  auto next = first;
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+  for (auto& slot : next.slots) slot.v_free += Vec<2>(u(rng), u(rng)) * slot.v_free.norm();
+  auto scratch = next;
+  const auto rc = contact::solve_active_set(next, s, &cache);
+  const auto rs = contact::solve_active_set(scratch, s);
+  ASSERT_TRUE(rc.converged);
+  EXPECT_EQ(rc.sweeps, rs.sweeps);
+  EXPECT_GE(rc.pivots, 1);  // the pivoting ran (the 10 sweeps did not suffice)
+  EXPECT_EQ(rc.pivots, rs.pivots);
+  for (std::size_t c = 0; c < next.contacts.size(); ++c)
+    EXPECT_EQ(next.contacts[c].impulse, scratch.contacts[c].impulse) << "contact " << c;
+  // The cached W is the one the problem gives (the compliances did not change).
+  EXPECT_EQ((cache.W - W).norm(), 0.0);
+  EXPECT_EQ((cache.W - contact::normal_system(next).W).norm(), 0.0);
+  // A changed compliance with the cache cleared, as the caller does: the new W is used.
+  auto stiffer = next;
+  for (auto& g : stiffer.groups) g.G *= 0.5;
+  cache.valid = false;
+  auto stiffer_scratch = stiffer;
+  contact::solve_active_set(stiffer, s, &cache);
+  contact::solve_active_set(stiffer_scratch, s);
+  for (std::size_t c = 0; c < stiffer.contacts.size(); ++c)
+    EXPECT_EQ(stiffer.contacts[c].impulse, stiffer_scratch.contacts[c].impulse) << "contact " << c;
+}
