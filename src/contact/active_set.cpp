@@ -15,12 +15,14 @@ namespace {
 constexpr int kMaxProximalSteps = 30;
 // Block pivots of one proximal step before the shift grows (cycling on an ill-conditioned W_AA).
 constexpr int kMaxPivots = 100;
-// Gauss-Seidel sweeps before the pivoting: they finish the easy problems (a warm start that is
-// nearly right) without assembling W, and give the others a first active set close to the
-// answer, from which block pivoting needs a few pivots instead of dozens of single ones (on 51
-// problems of the 40-disk compaction at d/16 that Gauss-Seidel needed 380 to 2,900 sweeps for:
-// 4 to 45 pivots, no sweep after, 36x less time than Gauss-Seidel).
-constexpr int kPreSweeps = 10;
+// Gauss-Seidel sweeps before the pivoting: one, which finishes the problems whose warm start is
+// right (the later Newton iterations of a step) without the pivoting. More sweeps give the
+// pivoting a better first active set but cost more than the pivots they save where W and the
+// factorisation are kept (ActiveSetCache): dense 300-disk state at d/8, 1.30-1.41 s per step with
+// 1 sweep against 1.83-1.86 s with 10 (3: 1.55 s); on 51 problems of the 40-disk case at d/16
+// that Gauss-Seidel needed 380 to 2,900 sweeps for: 1,650 pivots and 1.07 s with 1 sweep against
+// 502 and 0.87 s with 10, all solved without a sweep after (docs/contact.md).
+constexpr int kPreSweeps = 1;
 }  // namespace
 
 template <int Dim>
