@@ -30,12 +30,22 @@ struct NormalSystem {
 template <int Dim>
 NormalSystem normal_system(const Problem<Dim>& problem, bool with_matrix = true);
 
-/// A sparse LDL^T of W_AA + delta I for one active set A (the pivoting's linear solves).
+/// A sparse LDL^T of W_BB + delta I for one base set B of contacts, and what the pivoting's
+/// solves on other active sets A near B reuse: A differs from B by the contacts N that entered
+/// and R that left, and a solve on A borders the base factorisation with them (a Schur
+/// complement of |N| + |R| rows) instead of factorising W_AA + delta I anew.
 struct ShiftedFactor {
   double delta = 0;                  ///< the shift delta [s/kg]
-  std::vector<std::int32_t> active;  ///< the contacts of A, ascending (empty: nothing factorised)
-  Eigen::SparseMatrix<double> Waa;   ///< W restricted to A [s/kg]
+  std::vector<std::int32_t> active;  ///< the contacts of B, ascending (empty: nothing factorised)
+  Eigen::SparseMatrix<double> Waa;   ///< W restricted to B [s/kg]
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  ///< LDL^T of Waa + delta I
+  double factor_flops = 0;           ///< sum over L's columns of their count squared [-]
+  std::vector<std::int32_t> local;   ///< per contact: its index in B, or -1 [-]
+  std::vector<std::int32_t> column;  ///< per contact: its column of `solved`, or -1 [-]
+  std::vector<std::int32_t> owners;  ///< per column of `solved`: its contact [-]
+  /// (W_BB + delta I)^-1 c per contact that entered (c = W_Bn, then [-]) or left (c = e_r, then
+  /// [kg/s]) B in a solve since B was factorised.
+  Eigen::MatrixXd solved;
 };
 
 /// What one solve leaves for the next solve of the same contacts with the same compliances (the
