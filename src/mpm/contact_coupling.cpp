@@ -161,7 +161,18 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   }
   if (w.z_forward) {
     forward_substitute(w);
-    G.noalias() = w.Z.transpose() * w.ldlt.vectorD().cwiseInverse().asDiagonal() * w.Z;
+    const Eigen::VectorXd& d = w.ldlt.vectorD();
+    if (!(d.array() > 0.0).all()) {
+      G.noalias() = w.Z.transpose() * d.cwiseInverse().asDiagonal() * w.Z;
+      return true;
+    }
+    // D > 0 (the projected tangent keeps the grains' Newton matrices positive definite when
+    // they serve a compliance): G = S^T S with S = D^-1/2 Y, one triangle by a symmetric rank
+    // update (half the flops of the general product), mirrored.
+    const Eigen::MatrixXd S = d.cwiseInverse().cwiseSqrt().asDiagonal() * w.Z;
+    G.setZero(S.cols(), S.cols());
+    G.selfadjointView<Eigen::Lower>().rankUpdate(S.transpose());
+    G.triangularView<Eigen::StrictlyUpper>() = G.transpose();
     return true;
   }
   if (!w.lumped_group)
