@@ -73,6 +73,14 @@ double complementarity_violation(const contact::Problem<2>& p) {
   return worst / scale;
 }
 
+// Solver settings of these tests: tolerance 1e-12, sweeps unbounded in practice.
+contact::GsSettings tight() {
+  contact::GsSettings s;
+  s.tolerance = 1e-12;
+  s.max_sweeps = 100000;
+  return s;
+}
+
 // The problem solved by both solvers to 1e-12.
 struct BothSolved {
   contact::Problem<2> direct, sweeps;  // solved by solve_active_set, by solve_gauss_seidel
@@ -80,9 +88,7 @@ struct BothSolved {
 };
 BothSolved solve_both(const contact::Problem<2>& p) {
   BothSolved b{p, p, {}, {}};
-  contact::GsSettings s;
-  s.tolerance = 1e-12;
-  s.max_sweeps = 100000;
+  const contact::GsSettings s = tight();
   b.rd = contact::solve_active_set(b.direct, s);
   b.rg = contact::solve_gauss_seidel(b.sweeps, s);
   return b;
@@ -171,9 +177,7 @@ TEST(ActiveSet, CachedMatrixAndFactorisationGiveTheSameImpulses) {
   // give what a solve from scratch gives (bit for bit where the active set is the factorised
   // one; to round-off where the solve borders it).
   const auto base = two_grain_problem(20, 3, 11);
-  contact::GsSettings s;
-  s.tolerance = 1e-12;
-  s.max_sweeps = 100000;
+  const contact::GsSettings s = tight();
   contact::ActiveSetCache cache;
   auto first = base;
   const auto r1 = contact::solve_active_set(first, s, &cache);
@@ -216,9 +220,7 @@ TEST(ActiveSet, BorderedSolveMatchesAFreshFactorisation) {
   // (a Schur complement of the changed contacts) instead of factorising anew, and must reach the
   // solution a solve without the cache reaches.
   const auto base = two_grain_problem(60, 4, 17);
-  contact::GsSettings s;
-  s.tolerance = 1e-12;
-  s.max_sweeps = 100000;
+  const contact::GsSettings s = tight();
   contact::ActiveSetCache cache;
   auto first = base;
   ASSERT_TRUE(contact::solve_active_set(first, s, &cache).converged);
