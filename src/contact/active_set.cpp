@@ -194,7 +194,6 @@ class ShiftedSolver {
     n_entered_ = 0;
     in_active_.assign(static_cast<std::size_t>(W_.rows()), 0);
     for (const std::int32_t c : active) in_active_[static_cast<std::size_t>(c)] = 1;
-    std::vector<std::int32_t> left;
     for (const std::int32_t c : active)
       if (f_.local[static_cast<std::size_t>(c)] < 0) bordered_.push_back(c);
     n_entered_ = bordered_.size();
