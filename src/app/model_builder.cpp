@@ -286,6 +286,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
   c.gs.node_blocks = cfg.contact.node_blocks;
   c.impulse_tolerance = cfg.contact.impulse_tolerance;
   c.wall_range = cfg.contact.wall_range;
+  c.gap_horizon = cfg.contact.gap_horizon;
   c.wall_points = cfg.contact.wall_contact == "points";
   c.grain_faces = cfg.contact.grain_contact == "faces";
   c.active_set = cfg.contact.solver == "active_set";

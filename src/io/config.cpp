@@ -347,6 +347,13 @@ Schema build_schema() {
            .greater_than(0.0)
            .at_most(3.0)
            .default_of_member(),
+       KeySpec::number("gap_horizon", &ContactSection::gap_horizon, "",
+                       "grain_contact = \"faces\": a face becomes a contact only if its gap "
+                       "could close within this many steps at twice the step's largest speed "
+                       "(grain nodes, walls, plus gravity dt); farther faces cannot touch in "
+                       "the step. 0: every face within `wall_range` cells (docs/contact.md)")
+           .at_least(0.0)
+           .default_of_member(),
        KeySpec::string("wall_contact", &ContactSection::wall_contact,
                        "where a wall acts: \"nodes\" (a grain node's velocity may not cross "
                        "it) or \"points\" (the velocity of each point domain's face toward it, "

@@ -307,6 +307,19 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
     passes.push_back({B, A, 3, i0, i1});
     i0 = i1;
   }
+  // Faces farther than the gap that the step's largest approach speed could close within
+  // gap_horizon steps cannot touch in this step (their constraint is inactive at the solution)
+  // and are left out: a quarter of the faces in the dense paper state at d/8, half in the dilute
+  // one, and 26-34 % of the step time (docs/contact.md).
+  double cut = range;
+  if (cs.gap_horizon > 0) {
+    double speed = 0;
+    for (const auto& w : work_)
+      for (const Vec<Dim>& v : w->v) speed = std::max(speed, v.norm());
+    for (const Wall<Dim>& wall : cs.walls) speed = std::max(speed, wall.velocity.norm());
+    speed += settings_.gravity.norm() * dt_;
+    cut = std::min(range, cs.gap_horizon * 2.0 * speed * dt_);
+  }
   std::vector<std::vector<Hit>> hits(passes.size());
   double items = 0;
   const auto npasses = static_cast<std::int64_t>(passes.size());
@@ -351,7 +364,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
               if ((points_.x[q] - xf).norm() <= point_reach_[q] + range)
                 gap = std::min(gap, entry(q, xf, nu));
             });
-            if (!(gap <= range)) continue;
+            if (!(gap <= cut)) continue;
             for (int c = 0; c < corners; ++c) {
               Vec<Dim> sc = Vec<Dim>::Zero();
               sc[k] = sign;

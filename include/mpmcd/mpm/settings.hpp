@@ -68,6 +68,10 @@ struct ContactSettings {
   /// boundary face of either grain's points near the other grain against the other grain's
   /// velocity at the face's corners, along the face's normal. One MPI rank only for now.
   bool grain_faces = false;
+  /// With grain_faces: a face is a contact only if its gap g <= gap_horizon 2 V dt, V the step's
+  /// largest speed (grain nodes, walls) plus |gravity| dt, i.e. if it could close within
+  /// gap_horizon steps; 0: every face within wall_range cells [-].
+  double gap_horizon = 4.0;
   contact::GsSettings gs;  ///< Gauss-Seidel tolerance and sweep limit
   /// Solve each contact problem by block principal pivoting on the normal impulses
   /// (contact::solve_active_set; frictionless problems, one MPI rank) instead of Gauss-Seidel.
