@@ -56,40 +56,64 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
     if (k.a >= 0) by_resource[resource(k.a)].push_back({static_cast<std::int32_t>(c), k.a, -1.0});
   }
   if (!with_matrix) return sys;
-  // Each resource's entries on the threads, concatenated in resource order (the same matrix for
-  // any thread count).
-  const auto nres = static_cast<std::int64_t>(by_resource.size());
-  std::vector<std::vector<Eigen::Triplet<double>>> part(by_resource.size());
-#pragma omp parallel for schedule(dynamic, 4) if (ng > 1)
-  for (std::int64_t ri = 0; ri < nres; ++ri) {
-    const auto r = static_cast<std::size_t>(ri);
-    const auto& list = by_resource[r];
-    auto& out = part[r];
-    out.reserve(list.size() * list.size());
-    for (const Entry& e : list) {
-      const Vec<Dim>& ne = p.contacts[e.contact].normal;
-      for (const Entry& f : list) {
-        const Vec<Dim>& nf = p.contacts[f.contact].normal;
-        double v;
-        if (r >= ng) {
-          v = ne.dot(nf) / p.slots[e.slot].mass;  // one lumped slot: R = I / m
-        } else {
-          const Eigen::MatrixXd& G = p.groups[r].G;
-          v = ne.dot(
-              G.template block<Dim, Dim>(Dim * p.slots[e.slot].local, Dim * p.slots[f.slot].local) *
-              nf);
-        }
-        out.emplace_back(e.contact, f.contact, e.sign * f.sign * v);
-      }
+  // W column by column on the threads, straight into compressed storage: column c gathers the
+  // entries of the one or two resources of its slots, whose lists are in ascending contact
+  // order, merged (a contact sharing both resources with c gets both terms, added). A first
+  // pass counts each column's rows.
+  const auto value = [&](std::size_t r, const Entry& e, std::int32_t slot, double sign,
+                         const Vec<Dim>& n) {
+    const Vec<Dim>& ne = p.contacts[static_cast<std::size_t>(e.contact)].normal;
+    if (r >= ng) return e.sign * sign * ne.dot(n) / p.slots[slot].mass;  // lumped: R = I / m
+    const Eigen::MatrixXd& G = p.groups[r].G;
+    return e.sign * sign *
+           ne.dot(
+               G.template block<Dim, Dim>(Dim * p.slots[e.slot].local, Dim * p.slots[slot].local) *
+               n);
+  };
+  static const std::vector<Entry> kNone;
+  const auto lists = [&](const Contact<Dim>& k) {
+    return std::pair<const std::vector<Entry>*, const std::vector<Entry>*>(
+        &by_resource[resource(k.b)], k.a >= 0 ? &by_resource[resource(k.a)] : &kNone);
+  };
+  std::vector<Eigen::Index> count(static_cast<std::size_t>(m) + 1, 0);
+  const bool threads = ng > 1;
+#pragma omp parallel for schedule(dynamic, 64) if (threads)
+  for (Eigen::Index c = 0; c < m; ++c) {
+    const auto [l1, l2] = lists(p.contacts[static_cast<std::size_t>(c)]);
+    std::size_t i = 0, j = 0, n = 0;
+    while (i < l1->size() || j < l2->size()) {
+      const std::int32_t r1 = i < l1->size() ? (*l1)[i].contact : std::numeric_limits<int>::max();
+      const std::int32_t r2 = j < l2->size() ? (*l2)[j].contact : std::numeric_limits<int>::max();
+      i += r1 <= r2;
+      j += r2 <= r1;
+      ++n;
+    }
+    count[static_cast<std::size_t>(c) + 1] = static_cast<Eigen::Index>(n);
+  }
+  for (std::size_t c = 0; c < static_cast<std::size_t>(m); ++c) count[c + 1] += count[c];
+  sys.W.resize(m, m);
+  sys.W.resizeNonZeros(count.back());
+  for (Eigen::Index c = 0; c <= m; ++c)
+    sys.W.outerIndexPtr()[c] = static_cast<int>(count[static_cast<std::size_t>(c)]);
+  int* const rows = sys.W.innerIndexPtr();
+  double* const vals = sys.W.valuePtr();
+#pragma omp parallel for schedule(dynamic, 64) if (threads)
+  for (Eigen::Index c = 0; c < m; ++c) {
+    const Contact<Dim>& k = p.contacts[static_cast<std::size_t>(c)];
+    const auto [l1, l2] = lists(k);
+    const std::size_t r1 = resource(k.b), r2 = k.a >= 0 ? resource(k.a) : 0;
+    std::size_t i = 0, j = 0;
+    auto out = count[static_cast<std::size_t>(c)];
+    while (i < l1->size() || j < l2->size()) {
+      const std::int32_t c1 = i < l1->size() ? (*l1)[i].contact : std::numeric_limits<int>::max();
+      const std::int32_t c2 = j < l2->size() ? (*l2)[j].contact : std::numeric_limits<int>::max();
+      double v = 0;
+      if (c1 <= c2) v += value(r1, (*l1)[i++], k.b, 1.0, k.normal);
+      if (c2 <= c1) v += value(r2, (*l2)[j++], k.a, -1.0, k.normal);
+      rows[out] = std::min(c1, c2);
+      vals[out++] = v;
     }
   }
-  std::size_t total = 0;
-  for (const auto& t : part) total += t.size();
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(total);
-  for (const auto& t : part) triplets.insert(triplets.end(), t.begin(), t.end());
-  sys.W.resize(m, m);
-  sys.W.setFromTriplets(triplets.begin(), triplets.end());
   return sys;
 }
 

@@ -58,10 +58,11 @@ struct ActiveSetCache {
   ShiftedFactor factor;           ///< the last factorisation of the pivoting
 };
 
-/// Solves a problem whose contacts are all frictionless: up to 10 Gauss-Seidel sweeps from the
-/// impulses in `problem` (enough when they are nearly right), then block principal pivoting
-/// (above) from the active set they reach, then checks error(problem) and, if it is above
-/// settings.tolerance, continues with Gauss-Seidel sweeps (settings.max_sweeps). A problem with
+/// Solves a problem whose contacts are all frictionless: one Gauss-Seidel sweep from the
+/// impulses in `problem` (enough when they are nearly right; skipped when `cache` is valid), then
+/// block principal pivoting (above) from the active set it reaches, then checks error(problem)
+/// (computed from W) and, if it is above settings.tolerance, continues with Gauss-Seidel sweeps
+/// (settings.max_sweeps). A problem with
 /// a frictional contact goes to Gauss-Seidel directly. GsResult::pivots counts the pivoting
 /// steps, GsResult::sweeps all Gauss-Seidel sweeps. With a `cache` that is valid, its W and
 /// factorisation are used instead of being made again; it is left valid with this solve's.
