@@ -161,6 +161,8 @@ class ShiftedSolver {
     // kMaxRefinements while the residual halves after a bordered solve, whose Schur complement
     // loses digits on the nearly redundant contacts (with one step the two-grain block test
     // stalled at impulse changes of 4e-12 between Newton iterations).
+    // Stop at round-off: a residual within a few ulps of r's largest entry cannot fall further.
+    const double floor = 8 * std::numeric_limits<double>::epsilon() * r.cwiseAbs().maxCoeff();
     double last = std::numeric_limits<double>::infinity();
     for (int k = 0; k < (bordered_.empty() ? 1 : kMaxRefinements); ++k) {
       Eigen::VectorXd res = r;  // r - (W + delta I) x on A (x = 0 off A), 0 elsewhere
@@ -170,7 +172,7 @@ class ShiftedSolver {
           if (in_active_[static_cast<std::size_t>(it.row())]) res[it.row()] -= it.value() * x[c];
       }
       const double norm = res.cwiseAbs().maxCoeff();
-      if (!(norm < 0.5 * last)) break;
+      if (!(norm < 0.5 * last) || norm <= floor) break;
       last = norm;
       x += apply(res);
     }

@@ -174,8 +174,9 @@ TEST(ActiveSet, FrictionGoesToGaussSeidel) {
 TEST(ActiveSet, CachedMatrixAndFactorisationGiveTheSameImpulses) {
   // The Newton iterations of a step solve the same contacts and compliances with new free
   // velocities: a valid cache keeps W and the last factorisation of W_AA + delta I, and must
-  // give what a solve from scratch gives (bit for bit where the active set is the factorised
-  // one; to round-off where the solve borders it).
+  // give what a solve from scratch gives. With the cache the solve pivots from the warm start
+  // without a sweep first, so redundant contacts may share their load otherwise: the grains'
+  // (slots') net impulses, which the problem fixes, must agree to round-off.
   const auto base = two_grain_problem(20, 3, 11);
   const contact::GsSettings s = tight();
   contact::ActiveSetCache cache;
@@ -194,13 +195,15 @@ TEST(ActiveSet, CachedMatrixAndFactorisationGiveTheSameImpulses) {
   const auto rc = contact::solve_active_set(next, s, &cache);
   const auto rs = contact::solve_active_set(scratch, s);
   ASSERT_TRUE(rc.converged);
-  EXPECT_EQ(rc.sweeps, rs.sweeps);
-  EXPECT_GE(rc.pivots, 1);  // the pivoting ran (the first sweep did not suffice)
-  EXPECT_EQ(rc.pivots, rs.pivots);
-  for (std::size_t c = 0; c < next.contacts.size(); ++c)
-    EXPECT_NEAR((next.contacts[c].impulse - scratch.contacts[c].impulse).norm(), 0.0,
-                1e-12 * scratch.contacts[c].impulse.norm())
-        << "contact " << c;
+  ASSERT_TRUE(rs.converged);
+  EXPECT_EQ(rc.sweeps, 0);  // no sweep before the pivoting, none after
+  EXPECT_GE(rc.pivots, 1);
+  EXPECT_LT(complementarity_violation(next), 1e-10);
+  const auto a = contact::net_impulses(next), b = contact::net_impulses(scratch);
+  double scale = 0;
+  for (const auto& v : b) scale = std::max(scale, v.norm());
+  for (std::size_t k = 0; k < a.size(); ++k)
+    EXPECT_NEAR((a[k] - b[k]).norm(), 0.0, 1e-10 * scale) << "slot " << k;
   // The cached W is the one the problem gives (the compliances did not change).
   EXPECT_EQ((cache.W - W).norm(), 0.0);
   EXPECT_EQ((cache.W - contact::normal_system(next).W).norm(), 0.0);
@@ -246,7 +249,7 @@ TEST(ActiveSet, BorderedSolveMatchesAFreshFactorisation) {
   ASSERT_TRUE(rc.converged);
   ASSERT_TRUE(rs.converged);
   EXPECT_FALSE(cache.factor.owners.empty());  // bordered columns were made
-  EXPECT_EQ(rc.sweeps, 1);                    // the pivoting solved it, no sweep after
+  EXPECT_EQ(rc.sweeps, 0);  // pivoting from the warm start (no sweep first), no sweep after
   EXPECT_LT(complementarity_violation(next), 1e-10);
   const auto a = contact::net_impulses(next), b = contact::net_impulses(scratch);
   double scale = 0;
