@@ -143,6 +143,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
           if (A.g > B.g) std::swap(A, B);
           links.push_back({A.g, B.g, A.a, B.a});
         }
+    ScopedStage faces(&timers_, "contact.detect.faces");
     items += static_cast<double>(links.size()) + grain_face_contacts(links);
   }
   ThreadedRegion threaded(&timers_, nshared > 256);
@@ -208,6 +209,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
       problem_.contacts.push_back(c);
     }
   // 3. Grain-wall contacts: grain nodes within wall_range cells of a wall; gap from the points.
+  ScopedStage walls_stage(&timers_, "contact.detect.walls");
   // Node walls: each grain's candidates, gaps and warm starts on the threads, then the contacts in
   // the serial order (wall, grain, node).
   struct WallCandidate {
@@ -334,7 +336,9 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
       }
     }
   }
+  walls_stage.done();
   detect_items_ = items;
+  ScopedStage groups_stage(&timers_, "contact.detect.groups");
   // Warm start: the grains see the previous step's impulses from the first iteration on.
   slot_P_ = contact::net_impulses(problem_);
   spread_slot_impulses();

@@ -186,6 +186,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
     IVec<Dim> lo, n;                  // first cell and cell counts of the box
     std::vector<std::int32_t> start;  // per box cell (x fastest): offset into pts
     std::vector<std::int64_t> pts;    // the points, cell by cell
+    double max_reach = 0;             // the largest reach of its points [m]
   };
   std::vector<CellTable> by_cell(grains_.size());
   {
@@ -210,6 +211,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
         const IVec<Dim> c = cell_of(points_.x[p]);
         lo = lo.cwiseMin(c);
         hi = hi.cwiseMax(c);
+        t.max_reach = std::max(t.max_reach, point_reach_[p]);
       }
       t.lo = lo;
       t.n = hi - lo + IVec<Dim>::Ones();
@@ -330,6 +332,10 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
       const Pass& ps = passes[static_cast<std::size_t>(pi)];
       const std::int32_t X = ps.X, Y = ps.Y;
       const GrainWork& wx = *work_[X];
+      // Cells searched around a face centre for Y's domains: those within max reach + cut of it
+      // (at most the 2 cells searched before; usually 1 of them, a third of the points).
+      const int gap_radius = static_cast<int>(
+          std::min(2.0, std::ceil((by_cell[static_cast<std::size_t>(Y)].max_reach + cut) / h)));
       std::vector<std::int64_t> zone;
       for (std::size_t i = ps.i0; i < ps.i1; ++i)
         for (std::int32_t k = wx.node_pts_start[links[i][ps.col]];
@@ -359,9 +365,11 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
               interior = (point_dinv_[q] * (xt - points_.x[q])).cwiseAbs().maxCoeff() <= 1.0;
             });
             if (interior) continue;
+            // Only domains within `cut` of the face centre can give a gap <= cut (their reach
+            // bounds them), and once the face is inside one (gap <= 0) the gap is 0.
             double gap = std::numeric_limits<double>::infinity();
-            near(Y, xf, 2, [&](std::int64_t q) {
-              if ((points_.x[q] - xf).norm() <= point_reach_[q] + range)
+            near(Y, xf, gap_radius, [&](std::int64_t q) {
+              if (gap > 0.0 && (points_.x[q] - xf).norm() <= point_reach_[q] + cut)
                 gap = std::min(gap, entry(q, xf, nu));
             });
             if (!(gap <= cut)) continue;
