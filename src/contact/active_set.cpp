@@ -326,9 +326,8 @@ class ShiftedSolver {
 
 // The largest violation of p >= 0, w = b + W p >= 0, p w = 0 over the contacts, as an impulse
 // (w_c / W_cc), and the scale it is measured against (the largest impulse or |b_c| / W_cc).
-std::pair<double, double> violation(const NormalSystem& sys, const Eigen::SparseMatrix<double>& W,
+std::pair<double, double> violation(const NormalSystem& sys, const Eigen::VectorXd& w,
                                     const Eigen::VectorXd& d, const Eigen::VectorXd& p) {
-  const Eigen::VectorXd w = sys.b + W * p;
   double worst = 0, scale = 0;
   for (Eigen::Index c = 0; c < p.size(); ++c) {
     const double wc = w[c] / d[c];
@@ -341,9 +340,7 @@ std::pair<double, double> violation(const NormalSystem& sys, const Eigen::Sparse
 // Gauss-Seidel's error of frictionless contacts with impulses p: the relative distance
 // |loc - p| / |p| to their local solutions loc_c = max(0, p_c - w_c / W_cc), w = b + W p (the
 // local problem of contact c with the others' impulses fixed, method.md §4).
-double local_error(const NormalSystem& sys, const Eigen::SparseMatrix<double>& W,
-                   const Eigen::VectorXd& d, const Eigen::VectorXd& p) {
-  const Eigen::VectorXd w = sys.b + W * p;
+double local_error(const Eigen::VectorXd& w, const Eigen::VectorXd& d, const Eigen::VectorXd& p) {
   double num = 0, den = 0;
   for (Eigen::Index c = 0; c < p.size(); ++c) {
     const double loc = std::max(0.0, p[c] - w[c] / d[c]);
@@ -405,6 +402,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
     double delta = 1e-12 * w_max;
     ShiftedSolver solver(W, kept.factor, delta);
     Eigen::VectorXd p = sys.p.cwiseMax(0.0), q, w, next(m);
+    Eigen::VectorXd w_p;  // b + W p at the last accepted impulses p [m/s]
     std::vector<char> active(static_cast<std::size_t>(m));
     std::vector<std::int32_t> idx, infeasible;
     bool solved = false;
@@ -459,7 +457,8 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       p = next.cwiseMax(0.0);
       // Done when the violation meets the tolerance or stops falling (round-off, about 1e-14 of
       // the impulses): Gauss-Seidel's error then decides, and sweeps if it must.
-      const auto [worst, scale] = violation(sys, W, d, p);
+      w_p = sys.b + W * p;
+      const auto [worst, scale] = violation(sys, w_p, d, p);
       solved = worst <= 1e-3 * settings.tolerance * scale || worst > 0.5 * last;
       last = worst;
     }
@@ -472,7 +471,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       // Gauss-Seidel's error (error(problem)) from W, without the slot velocities: each
       // frictionless contact's local solution max(0, p_c - w_c / W_cc) (the others' impulses
       // fixed) against its impulse, |loc - p| / |p|. Met: no sweep.
-      result.error = local_error(sys, W, d, p);
+      result.error = local_error(w_p, d, p);
       if (result.error <= settings.tolerance) {
         result.converged = true;
         return result;
