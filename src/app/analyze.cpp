@@ -277,7 +277,7 @@ int analyze_command(const AnalyzeOptions& opt) {
                    [](const std::string& f) {
                      for (const char* own :
                           {"compaction_fit.csv", "figure4.csv", "figure5.csv", "figure4.png",
-                           "figure5.png", "pressure_law.csv", "phi_pressure.csv", "fabric.csv",
+                           "figure5.png", "figure4.pdf", "figure5.pdf", "pressure_law.csv", "phi_pressure.csv", "fabric.csv",
                            "force_distribution.csv", "pressure_distribution.csv",
                            "pressure_law.png", "pressure_law.pdf", "fabric.png", "fabric.pdf",
                            "distributions.png", "distributions.pdf"})
@@ -421,7 +421,7 @@ int analyze_command(const AnalyzeOptions& opt) {
   if (std::system(cmd.c_str()) != 0)
     std::cout << "PNGs not written: " << cmd << " failed\n";
   else
-    std::cout << fmt::format("wrote {}/figure4.png, figure5.png\n", out_dir);
+    std::cout << fmt::format("wrote {}/figure4.png, figure5.png and .pdf\n", out_dir);
   // tools/plot_grains.py, next to plot_compaction.py: the pressure law, the fabric and the
   // distributions (PNG and PDF).
   const fs::path grains_script = fs::path(script).parent_path() / "plot_grains.py";

@@ -238,6 +238,7 @@ TEST(Analyze, ThreeSyntheticRunsOverlaidRecoverC1C2) {
   if (r.output.find("PNGs not written") == std::string::npos) {
     EXPECT_TRUE(fs::exists(dir / "analysis" / "figure4.png")) << r.output;
     EXPECT_TRUE(fs::exists(dir / "analysis" / "figure5.png")) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "analysis" / "figure5.pdf")) << r.output;
   }
   const fs::path fit = dir / "analysis" / "compaction_fit.csv";
   for (std::size_t k = 0; k < 3; ++k) {
