@@ -150,7 +150,9 @@ std::vector<mpm::WarmImpulse<Dim>> warm_start_of(const checkpoint::State& s) {
 
 namespace {
 constexpr std::size_t kLoadingStageValues = 5;  // checkpoint::State::loading_stage
-constexpr std::size_t kLoadingWallValues = 12;  // checkpoint::State::loading_wall, per wall
+// checkpoint::State::loading_wall, per wall: 13 since the servo's integral, 12 before (read as
+// an integral of 0).
+constexpr std::size_t kLoadingWallValues = 13, kLoadingWallValuesBefore = 12;
 }  // namespace
 
 void store_loading(const LoadingState& l, checkpoint::State& s) {
@@ -162,7 +164,7 @@ void store_loading(const LoadingState& l, checkpoint::State& s) {
     s.loading_control.push_back(static_cast<std::int32_t>(p.control));
     for (const double x :
          {p.v_from[0], p.v_from[1], p.v_to[0], p.v_to[1], p.s_from, p.s_to, p.t_start, p.ramp,
-          l.velocity[k][0], l.velocity[k][1], l.force[k][0], l.force[k][1]})
+          l.velocity[k][0], l.velocity[k][1], l.force[k][0], l.force[k][1], l.integral[k]})
       s.loading_wall.push_back(x);
   }
 }
@@ -172,7 +174,10 @@ LoadingState loading_state_of(const checkpoint::State& s) {
   if (s.loading_stage.size() != kLoadingStageValues)
     throw std::invalid_argument(
         "the input has [loading], the checkpoint no loading state (written without it)");
-  if (s.loading_wall.size() != nw * kLoadingWallValues || s.wall_point.size() != 2 * nw)
+  const std::size_t per_wall = nw > 0 && s.loading_wall.size() == nw * kLoadingWallValuesBefore
+                                   ? kLoadingWallValuesBefore
+                                   : kLoadingWallValues;
+  if (s.loading_wall.size() != nw * per_wall || s.wall_point.size() != 2 * nw)
     throw std::invalid_argument(fmt::format(
         "the checkpoint's loading state has {} values for {} walls, expected {} per wall",
         s.loading_wall.size(), nw, kLoadingWallValues));
@@ -183,7 +188,7 @@ LoadingState loading_state_of(const checkpoint::State& s) {
   l.eps0 = s.loading_stage[3];
   l.stress0 = s.loading_stage[4];
   for (std::size_t k = 0; k < nw; ++k) {
-    const double* x = &s.loading_wall[k * kLoadingWallValues];
+    const double* x = &s.loading_wall[k * per_wall];
     if (s.loading_control[k] != 0 && s.loading_control[k] != 1)
       throw std::invalid_argument(fmt::format("wall {} has control {}", k, s.loading_control[k]));
     WallProgram p;
@@ -197,6 +202,7 @@ LoadingState loading_state_of(const checkpoint::State& s) {
     l.programs.push_back(p);
     l.velocity.emplace_back(x[8], x[9]);
     l.force.emplace_back(x[10], x[11]);
+    l.integral.push_back(per_wall > kLoadingWallValuesBefore ? x[12] : 0.0);
     l.position.emplace_back(s.wall_point[2 * k], s.wall_point[2 * k + 1]);
   }
   return l;

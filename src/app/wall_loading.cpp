@@ -43,7 +43,10 @@ WallLoading::WallLoading(const io::Config& config, const std::vector<mpm::Wall<2
   for (std::size_t k = 0; k < nw; ++k) state_.position[k] = walls[k].point;
   state_.velocity.assign(nw, Vec<2>::Zero());
   state_.force.assign(nw, Vec<2>::Zero());
+  state_.integral.assign(nw, 0.0);
   pending_.assign(nw, Vec<2>::Zero());
+  pending_error_.assign(nw, 0.0);
+  integral_time_ = config.loading.integral_time;
   if (!active_) return;
   for (const auto& st : config.loading.stages) {
     std::size_t u = 0;
@@ -86,8 +89,9 @@ WallLoading::WallLoading(const io::Config& config, const std::vector<mpm::Wall<2
 
 std::string WallLoading::describe() const {
   return fmt::format(
-      "loading: {} stage(s); servo gain g = {:.6g} m/(s Pa) ({}), speed limit {:.6g} m/s ({})",
-      section_->stages.size(), gain_, gain_source_, max_speed_, speed_source_);
+      "loading: {} stage(s); servo gain g = {:.6g} m/(s Pa) ({}), speed limit {:.6g} m/s ({}){}",
+      section_->stages.size(), gain_, gain_source_, max_speed_, speed_source_,
+      integral_time_ > 0 ? fmt::format(", integral time {:.6g} s", integral_time_) : "");
 }
 
 std::vector<analysis::Plane> WallLoading::planes() const {
@@ -140,6 +144,9 @@ void WallLoading::begin_stage(std::size_t k, double t, double grain_area) {
     next.ramp = st.ramp;
     if (e.has_stress) {
       next.control = WallControl::kStress;
+      // A wall that becomes a servo starts its integral from zero; one that stays a servo keeps
+      // it (the lag it compensates goes on).
+      if (prog.control != WallControl::kStress) state_.integral[w] = 0.0;
       // From the target held so far, or from the stress the wall measures if it moved at a
       // prescribed velocity; the slide from the velocity's tangential part.
       next.s_from = prog.control == WallControl::kStress ? prog.stress_at(t) : measured_stress(w);
@@ -148,6 +155,7 @@ void WallLoading::begin_stage(std::size_t k, double t, double grain_area) {
       next.v_to = v_to;
     } else {
       next.control = WallControl::kVelocity;
+      state_.integral[w] = 0.0;
       next.v_from = v_now;
       next.v_to = v_to;
     }
@@ -160,12 +168,17 @@ std::vector<mpm::Wall<2>> WallLoading::step_walls(double t, double dt) {
   for (std::size_t k = 0; k < out.size(); ++k) {
     const WallProgram& prog = state_.programs[k];
     Vec<2> v = prog.velocity_at(t + dt);
+    pending_error_[k] = 0.0;
     if (prog.control == WallControl::kStress) {
-      // The servo (docs/loading.md): v_n = clamp(g (sigma_measured - sigma_target), +-v_max),
-      // positive into the domain, so a wall pressed less than its target advances.
+      // The servo (docs/loading.md): v_n = clamp(g (e + I/T_i), +-v_max), e = sigma_measured -
+      // sigma_target, positive into the domain, so a wall pressed less than its target advances.
       const Vec<2> n = walls0_[k].normal;
-      const double vn = std::clamp(gain_ * (measured_stress(k) - prog.stress_at(t + dt)),
-                                   -max_speed_, max_speed_);
+      const double e = measured_stress(k) - prog.stress_at(t + dt);
+      const double wanted =
+          gain_ * (integral_time_ > 0 ? e + state_.integral[k] / integral_time_ : e);
+      const double vn = std::clamp(wanted, -max_speed_, max_speed_);
+      // Conditional integration (anti-wind-up): not while the speed limit holds the wall.
+      if (integral_time_ > 0 && vn == wanted) pending_error_[k] = e;
       v = (v - v.dot(n) * n) + vn * n;
     }
     pending_[k] = v;
@@ -180,6 +193,7 @@ void WallLoading::committed(const mpm::StepStats& st, double dt) {
   for (std::size_t k = 0; k < pending_.size(); ++k) {
     state_.position[k] += dt * pending_[k];
     state_.velocity[k] = pending_[k];
+    state_.integral[k] += dt * pending_error_[k];
     state_.force[k] = k < st.wall_force.size() ? Vec<2>(st.wall_force[k][0], st.wall_force[k][1])
                                                : Vec<2>::Zero();
   }
@@ -272,7 +286,7 @@ std::string WallLoading::csv_fields(double t) const {
 void WallLoading::restore(LoadingState state) {
   const std::size_t nw = walls0_.size();
   if (state.programs.size() != nw || state.position.size() != nw || state.velocity.size() != nw ||
-      state.force.size() != nw)
+      state.force.size() != nw || state.integral.size() != nw)
     throw std::invalid_argument(
         fmt::format("loading state for {} walls, the input has {}", state.programs.size(), nw));
   if (state.stage < 0 || static_cast<std::size_t>(state.stage) > section_->stages.size())

@@ -438,6 +438,13 @@ Schema build_schema() {
                        "speed limit of a stress-controlled wall")
            .greater_than(0.0)
            .defaults("0.02 c_p (the grains' slowest P-wave speed)"),
+       KeySpec::number("integral_time", &LoadingSection::integral_time, "s",
+                       "integral time T_i of the servo: v_n = clamp(gain (e + I/T_i)), I the "
+                       "time integral of the stress error e while the wall is stress-controlled "
+                       "and not at its speed limit; removes the lag v/gain of a servo following "
+                       "a moving sample (docs/loading.md, \"Integral action\"); 0: off")
+           .at_least(0.0)
+           .default_of_member(),
        KeySpec::table_array("stages", &LoadingSection::stages, "the loading stages, in order")
            .require()
            .nonempty()});

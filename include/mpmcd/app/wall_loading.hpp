@@ -1,7 +1,8 @@
 #pragma once
 /// Wall loading in stages ([loading], docs/loading.md): each wall is velocity- or
 /// stress-controlled; a stress-controlled wall is a servo, its normal velocity over the next step
-/// v_n = clamp(g (sigma_measured - sigma_target), -v_max, v_max) with sigma_measured the normal
+/// v_n = clamp(g (e + I/T_i), -v_max, v_max), e = sigma_measured - sigma_target, I the time
+/// integral of e (integral_time T_i > 0, else the term is absent), with sigma_measured the normal
 /// stress of the wall's force in the last step (mpm::StepStats::wall_force over the wall's length
 /// in the box, analysis::wall_normal_stress). Targets go linearly to a stage's values over its ramp
 /// and are then held; a stage ends at the first of its `until` conditions. Explicit in the wall
@@ -55,6 +56,9 @@ struct LoadingState {
   std::vector<Vec<2>> position;       ///< per wall: a point of its plane at the current time [m]
   std::vector<Vec<2>> velocity;       ///< per wall: its velocity in the last step [m/s]
   std::vector<Vec<2>> force;  ///< per wall: force of the grains on it in the last step [N/m]
+  /// Per wall: the servo's integral I of the stress error over time ([loading] integral_time;
+  /// 0 when off or while velocity-controlled) [Pa s].
+  std::vector<double> integral;
 };
 
 /// The walls' motion under [loading] (inactive without it: the walls keep their input velocity).
@@ -127,11 +131,15 @@ class WallLoading {
   analysis::Box box0_;                     // the box at t = 0
   std::vector<std::size_t> until_wall_;    // per stage: index of until.wall (or 0)
   double gain_ = 0.0, max_speed_ = 0.0;
+  double integral_time_ = 0.0;  // servo integral time T_i (0: off) [s]
   std::string gain_source_, speed_source_;
   double vs0_ = 0.0;       // grain area at t = 0 [m^2]
   double eps_time_ = 0.0;  // time tolerance of until.time [s]
   LoadingState state_;
   std::vector<Vec<2>> pending_;  // velocities of the step being tried [m/s]
+  // Servo walls of the step being tried: the stress error e [Pa] to integrate when committed,
+  // 0 for a velocity-controlled wall or one at its speed limit (no wind-up).
+  std::vector<double> pending_error_;
 };
 
 }  // namespace mpmcd::app

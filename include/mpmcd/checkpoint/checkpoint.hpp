@@ -13,7 +13,7 @@
 namespace mpmcd::checkpoint {
 
 /// Layout version of the files this build writes and reads [-].
-inline constexpr std::int32_t kFormatVersion = 7;
+inline constexpr std::int32_t kFormatVersion = 8;
 
 /// Oldest layout version this build still reads (version 6: no wall loading) [-].
 inline constexpr std::int32_t kOldestFormatVersion = 6;

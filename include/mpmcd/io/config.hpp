@@ -181,6 +181,7 @@ struct LoadingSection {
   double gain = 0.0;  ///< servo gain g, v_n = g (σ_measured - σ_target) [m/(s Pa)] (0: auto)
   double gain_fraction = 0.25;       ///< auto gain: this fraction of min(dt/(ρ h), h/(M_p dt)) [-]
   double max_speed = 0.0;            ///< speed limit of a servo wall [m/s] (0: auto)
+  double integral_time = 0.0;        ///< servo integral time T_i [s] (0: proportional servo only)
   std::vector<StageSection> stages;  ///< the stages, in order
   bool present = false;              ///< the [loading] table was given [-]
   std::int64_t line = 0;             ///< line of the table in the input

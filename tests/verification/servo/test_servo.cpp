@@ -3,10 +3,12 @@
 // holds the target stress within 1 % after its settling time (wall stresses, every point's
 // sigma22 and the closed form of uniaxial strain, method.md §7); stages end on their `until`
 // conditions (stress, time, strain) and ramps follow their line; a restart in the middle of a
-// stage continues bitwise.
+// stage continues bitwise; a biaxial test (side walls servos with integral action, top wall at a
+// velocity) keeps the lateral stress and the closed form of F = diag(a, s).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -144,11 +146,12 @@ TEST(Servo, HoldsTargetStressOnElasticBlockWithinOnePercent) {
 namespace {
 
 // The coarse block (h = 0.2 mm, 100 points) driven through four stages that end on a stress, a
-// time, and two strains; `every` [s] CSV interval.
+// time, and two strains; the servo of the hold stage has an integral term (its integral is state
+// that a restart must carry).
 std::string staged_input(const std::string& checkpoint = "") {
   return block_input(
       2e-4, 2e-6, 2e-3,
-      "[loading]\n"
+      "[loading]\nintegral_time = 1e-4\n"
       "[[loading.stages]]\nname = \"approach\"\nuntil = { stress = -2e5, wall = \"top\" }\n"
       "[[loading.stages.walls]]\nname = \"top\"\nvelocity = [0.0, -0.5]\n"
       "[[loading.stages]]\nname = \"hold\"\nuntil = { time = 1e-4 }\n"
@@ -226,6 +229,8 @@ TEST(Loading, RestartMidStageIsBitwise) {
   ASSERT_EQ(mid.loading_stage.size(), 5u);
   EXPECT_EQ(mid.loading_stage[0], 1.0) << "not in the hold stage";
   EXPECT_EQ(mid.loading_control.at(1), 1) << "the top wall is not stress-controlled";
+  ASSERT_EQ(mid.loading_wall.size(), 4u * 13u);
+  EXPECT_NE(mid.loading_wall[13 + 12], 0.0) << "the top wall's servo integral is not stored";
   const auto restart = mpmcd::app::load_restart(first.checkpoint, "");
   mpmcd::app::RunOptions ropt;
   ropt.threads = 1;
@@ -241,4 +246,95 @@ TEST(Loading, RestartMidStageIsBitwise) {
   EXPECT_EQ(ck::payload_checksum(a), ck::payload_checksum(b));
   EXPECT_EQ(a.loading_wall, b.loading_wall);
   EXPECT_EQ(a.wall_point, b.wall_point);
+}
+
+namespace {
+
+// Cauchy stress sigma_kk of the homogeneous state F = diag(a, s) (method.md §7):
+// [mu (stretch^2 - 1) + lambda ln J] / J, J = a s, stretch a for sigma11 and s for sigma22 [Pa].
+double sigma_biaxial(double stretch, double a, double s) {
+  const double j = a * s;
+  return (kMu * (stretch * stretch - 1) + kLambda * std::log(j)) / j;
+}
+
+}  // namespace
+
+// The biaxial test of docs/loading.md on the block: stage 1 brings the four walls to the
+// confining stress -p0 (equibiaxial state); stage 2 keeps the side walls at -p0 (servos) while
+// the top wall moves down at a constant speed (bottom at rest) until eps = -0.1. During the
+// compression the side walls move out by themselves; after a settling time the side walls hold
+// -p0 within 1 %, and the top wall stress, the Love-Weber stress and every point's stress are
+// those of F = diag(a, s) with a and s read from the walls' positions.
+TEST(Loading, BiaxialHoldsTheLateralStressWhileTheTopWallMoves) {
+  const fs::path dir = scratch("biaxial");
+  const double p0 = 1e5, v = 0.1;  // confining stress [Pa], top wall speed [m/s]
+  std::ostringstream loading;
+  loading << "[loading]\nintegral_time = 1e-4\n"
+             "[[loading.stages]]\nname = \"confine\"\nramp = 1e-4\nuntil = { time = 5e-4 }\n"
+             "walls = [{ name = \"bottom\", stress = "
+          << -p0 << " }, { name = \"top\", stress = " << -p0
+          << " },\n         { name = \"left\", stress = " << -p0
+          << " }, { name = \"right\", stress = " << -p0
+          << " }]\n"
+             "[[loading.stages]]\nname = \"compress\"\nramp = 5e-5\nuntil = { strain = -0.1 }\n"
+             "walls = [{ name = \"bottom\", velocity = [0.0, 0.0] }, { name = \"top\", velocity "
+             "= [0.0, "
+          << -v << "] }]\n";
+  const auto summary = run(block_input(1e-4, 1e-6, 3e-3, loading.str()), dir);
+  EXPECT_NE(summary.stop_reason.find("loading finished: loading stage 2 ('compress')"),
+            std::string::npos)
+      << summary.stop_reason;
+  const auto csv = mpmcd::analysis::read_time_series((dir / "out" / "block.csv").string());
+  const auto& t = csv.column("time");
+  const auto& stage = csv.column("stage");
+  const auto& top = csv.column("wall_top_stress");
+  const auto& left = csv.column("wall_left_stress");
+  const auto& right = csv.column("wall_right_stress");
+  const auto& lw_xx = csv.column("lw_sxx");
+  const auto& lw_yy = csv.column("lw_syy");
+  const auto& h_box = csv.column("h");
+  const auto& width = csv.column("width");
+  const auto& vx = csv.column("wall_right_vx");
+  // The end of stage 1 (settled): the equibiaxial state within 1 %.
+  std::size_t start2 = 0;
+  for (std::size_t i = 1; i < csv.rows() && !start2; ++i)
+    if (stage[i] == 2) start2 = i;
+  ASSERT_GT(start2, 0u);
+  for (const auto* col : {&top, &left, &right})
+    EXPECT_NEAR((*col)[start2 - 1], -p0, 0.01 * p0) << "end of the confinement";
+  // Stage 2 after 0.3 ms of compression (about 4 settling times of the side servos).
+  const double t_check = t[start2] + 3e-4;
+  int checked = 0;
+  double worst_side = 0, worst_top = 0;
+  for (std::size_t i = start2; i < csv.rows(); ++i) {
+    if (t[i] < t_check) continue;
+    ++checked;
+    const double a = width[i] / kH0, s = h_box[i] / kH0;
+    const double s11 = sigma_biaxial(a, a, s), s22 = sigma_biaxial(s, a, s);
+    worst_side = std::max(worst_side, std::fabs(left[i] + p0) / p0);
+    worst_top = std::max(worst_top, std::fabs(top[i] - s22) / std::fabs(s22));
+    EXPECT_NEAR(left[i], -p0, 0.01 * p0) << "left wall at t = " << t[i];
+    EXPECT_NEAR(right[i], -p0, 0.01 * p0) << "right wall at t = " << t[i];
+    EXPECT_NEAR(top[i], s22, 1e-3 * std::fabs(s22)) << "top wall at t = " << t[i];
+    EXPECT_NEAR(left[i], s11, 1e-3 * std::fabs(s11)) << "left wall at t = " << t[i];
+    EXPECT_NEAR(lw_yy[i], s22, 1e-3 * std::fabs(s22)) << "Love-Weber at t = " << t[i];
+    EXPECT_NEAR(lw_xx[i], s11, 1e-3 * std::fabs(s11)) << "Love-Weber at t = " << t[i];
+    EXPECT_GT(vx[i], 0.0) << "the right wall does not move out at t = " << t[i];
+  }
+  EXPECT_GT(checked, 50);
+  // Every point's stress at the end (the final checkpoint holds them).
+  const ck::State st = ck::read(summary.checkpoint);
+  const double a = width.back() / kH0, s = h_box.back() / kH0;
+  double worst_point = 0;
+  for (std::size_t p = 0; p < st.points(); ++p) {
+    worst_point = std::max(worst_point, std::fabs(st.sigma[4 * p] - sigma_biaxial(a, a, s)) /
+                                            std::fabs(sigma_biaxial(a, a, s)));
+    worst_point = std::max(worst_point, std::fabs(st.sigma[4 * p + 3] - sigma_biaxial(s, a, s)) /
+                                            std::fabs(sigma_biaxial(s, a, s)));
+  }
+  EXPECT_LT(worst_point, 1e-3);
+  std::printf(
+      "  biaxial block: end a = %.5f, s = %.5f; worst side wall / -p0 - 1: %.2e, worst top wall "
+      "against the closed form: %.2e, worst point: %.2e\n",
+      a, s, worst_side, worst_top, worst_point);
 }
