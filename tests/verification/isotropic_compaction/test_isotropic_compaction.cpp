@@ -1,10 +1,12 @@
 // The CI version of examples/isotropic_compaction run through the command line as a user runs
-// it: 20 soft frictionless disks in a box of four servo walls, the pressure stepped to P/mu =
-// 0.05, 0.1, 0.2 and held for 0.15 ms each. Phi rises with P at the end of every hold, and every
-// wall's stress holds its target there (the mean over the last third of the hold).
+// it: 20 soft frictionless disks in a box of four servo walls, contact on the material surface,
+// the pressure stepped to P/mu = 0.05, 0.1, 0.2, 0.3, 0.4, 0.5 and held. Over the last third of
+// every hold: Phi and phi_geometric rise with P, every wall's stress is within 1 % of its target,
+// and the grains do not interpenetrate beyond the grid's trace.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -25,26 +27,34 @@ TEST(IsotropicCompaction, PhiRisesWithPressureAndTheWallsHoldTheirTargets) {
       std::string(MPMCD_SOURCE_DIR) + "/examples/isotropic_compaction/isotropic_compaction_ci.toml";
   const auto r = mpmcd::test_support::run("run -t 1 " + input + " -o " + dir.string());
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("loading finished: loading stage 3 ('P/mu = 0.2')"), std::string::npos)
+  EXPECT_NE(r.output.find("loading finished: loading stage 6 ('P/mu = 0.5')"), std::string::npos)
       << r.output;
   const auto csv =
       mpmcd::analysis::read_time_series((dir / "isotropic_compaction_ci.csv").string());
   const auto& t = csv.column("time");
+  const auto& stage = csv.column("stage");
   const auto& phi = csv.column("phi");
   const auto& phi_geometric = csv.column("phi_geometric");
+  const auto& overlap = csv.column("overlap_over_Vs");
   const char* walls[] = {"bottom", "top", "left", "right"};
-  constexpr double kMu = 1.5e6, kHold = 1.5e-4;  // [Pa], stage duration [s]
-  const double p_over_mu[] = {0.05, 0.1, 0.2};
+  constexpr double kMu = 1.5e6;  // [Pa]
+  const double p_over_mu[] = {0.05, 0.1, 0.2, 0.3, 0.4, 0.5};
   double last_phi = 0, last_geometric = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double target = -p_over_mu[k] * kMu, end = (k + 1) * kHold;
-    // The last third of the hold (the ramp takes its first 20 us).
-    double n = 0, mean_phi = 0, mean_geometric = 0, mean_stress[4] = {0, 0, 0, 0};
+  for (int k = 0; k < 6; ++k) {
+    const double target = -p_over_mu[k] * kMu;
+    // The hold: the rows of stage k + 1 (the ramp takes its first 20 us); its last third.
+    double begin = 1e300, end = -1e300;
+    for (std::size_t i = 0; i < csv.rows(); ++i)
+      if (stage[i] == k + 1) begin = std::min(begin, t[i]), end = std::max(end, t[i]);
+    ASSERT_LT(begin, end) << "stage " << k + 1 << " has no rows";
+    double n = 0, mean_phi = 0, mean_geometric = 0, max_overlap = 0;
+    double mean_stress[4] = {0, 0, 0, 0};
     for (std::size_t i = 0; i < csv.rows(); ++i) {
-      if (t[i] < end - kHold / 3 - 1e-12 || t[i] > end + 1e-12) continue;
+      if (stage[i] != k + 1 || t[i] < end - (end - begin) / 3) continue;
       n += 1;
       mean_phi += phi[i];
       mean_geometric += phi_geometric[i];
+      max_overlap = std::max(max_overlap, overlap[i]);
       for (int w = 0; w < 4; ++w) {
         const std::string name = std::string("wall_") + walls[w];
         mean_stress[w] += csv.column(name + "_stress")[i];
@@ -58,15 +68,20 @@ TEST(IsotropicCompaction, PhiRisesWithPressureAndTheWallsHoldTheirTargets) {
     EXPECT_GT(mean_geometric, last_geometric) << "P/mu = " << p_over_mu[k];
     last_phi = mean_phi;
     last_geometric = mean_geometric;
-    std::printf("  P/mu = %.2f: Phi = %.4f, phi_geometric = %.4f, wall stress / target:",
-                p_over_mu[k], mean_phi, mean_geometric);
+    // Interpenetration: with faces the domains of two grains overlap by O(h^2), 0.7 % of V_s at
+    // P/mu = 0.05 to 1.9 % at 0.5 on this grid (0.16-0.48 % at half the cell size); the node
+    // contact reached 6 % during a long hold at P/mu = 0.2 (examples/isotropic_compaction).
+    EXPECT_LT(max_overlap, 0.025) << "P/mu = " << p_over_mu[k];
+    std::printf(
+        "  P/mu = %.2f: Phi = %.4f, phi_geometric = %.4f, overlap/V_s <= %.4f, wall stress / "
+        "target:",
+        p_over_mu[k], mean_phi, mean_geometric, max_overlap);
     for (int w = 0; w < 4; ++w) {
       mean_stress[w] /= n;
       std::printf(" %s %.4f", walls[w], mean_stress[w] / target);
-      // 2.5 %: the packing still creeps slowly during the holds (Phi rises), and a servo
-      // following a creeping packing lags its target by v_n / g (docs/loading.md); the elastic
-      // block, which settles, holds 1 % (tests/verification/servo).
-      EXPECT_NEAR(mean_stress[w], target, 0.025 * std::fabs(target))
+      // 1 %: the servo's target once the packing has settled (docs/loading.md); the elastic
+      // block holds it too (tests/verification/servo).
+      EXPECT_NEAR(mean_stress[w], target, 0.01 * std::fabs(target))
           << walls[w] << " wall at P/mu = " << p_over_mu[k];
     }
     std::printf("\n");
