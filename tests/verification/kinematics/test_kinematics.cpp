@@ -1,7 +1,8 @@
 // Kinematic verification with the whole grid driven by a prescribed affine velocity field:
 // patch test (affine fields reproduced exactly), homogeneous plane-strain compression and simple
 // shear against the closed forms of method.md §7 (1e-8 relative), and objectivity (a 90 degree
-// rigid rotation creates no stress above round-off).
+// rigid rotation creates no stress above round-off, and a full turn brings every point back with
+// J = 1 and no stress, for every shape family with and without affine P2G).
 #include <gtest/gtest.h>
 
 #include <numbers>
@@ -21,9 +22,10 @@ namespace {
 
 // Drives every node with du = (dF - I)(x - c) per step (theta = 1, so v = du / dt), n steps.
 void drive(mpm::Model<2>& model, grid::ShapeKind shape, const Mat<2>& dF, const Vec<2>& c,
-           int steps, double dt = 1e-3, double flip = 1.0) {
+           int steps, double dt = 1e-3, double flip = 1.0, bool affine = false) {
   mpm::Settings<2> s;
   s.shape = shape;
+  s.affine = affine;
   s.theta = 1.0;
   s.flip = flip;
   mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
@@ -147,4 +149,39 @@ TEST(Kinematics, RigidRotationBy90DegreesCreatesNoStress) {
     EXPECT_LT(smax, 1e-8 * kMu);
     EXPECT_LT(xmax, 1e-12);
   }
+}
+
+// A full turn in 72 steps of 5 degrees (the grid's nodes moved along the chords of the rotation,
+// du = (R - I)(x - c), so every step is an exact rotation): every point back at its start, F back
+// to I (J = 1) and no stress, to round-off, for linear, uGIMP and CPDI shapes, with and without
+// affine P2G (issue 14: "a disk rotated by 360 degrees keeps J = 1 and sigma = 0 to 1e-8"). A
+// freely spinning disk is another problem: it carries the centrifugal stress rho omega^2 R^2.
+TEST(Kinematics, FullTurnBringsEveryPointBackUnstrained) {
+  for (auto shape : {grid::ShapeKind::kLinear, grid::ShapeKind::kUGimp, grid::ShapeKind::kCpdi})
+    for (const bool affine : {false, true}) {
+      auto model = make_model(0.1, 30, 30, "neo_hookean", kLambda, kMu, kRho);
+      add_disk(model, Vec<2>(1.5, 1.5), 0.5, 2);
+      const Vec<2> c(1.5, 1.5);
+      const auto X = model.points.x;
+      const int steps = 72;
+      const double a = 2 * std::numbers::pi / steps;
+      Mat<2> R;
+      R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+      drive(model, shape, R, c, steps, 1e-3, 1.0, affine);
+      double smax = 0, xmax = 0, jmax = 0, fmax = 0;
+      for (std::size_t p = 0; p < model.points.size(); ++p) {
+        smax = std::max(smax, model.points.sigma[p].cwiseAbs().maxCoeff());
+        xmax = std::max(xmax, (model.points.x[p] - X[p]).norm());
+        jmax = std::max(jmax, std::fabs(model.points.F[p].determinant() - 1.0));
+        fmax = std::max(fmax, (model.points.F[p] - Mat<2>::Identity()).norm());
+      }
+      std::printf(
+          "  full turn, shape %d, affine %d: max |sigma| = %.3e Pa, |J - 1| = %.2e, |F - I| = "
+          "%.2e, position error %.2e m\n",
+          static_cast<int>(shape), affine ? 1 : 0, smax, jmax, fmax, xmax);
+      EXPECT_LT(smax, 1e-8 * kMu);
+      EXPECT_LT(jmax, 1e-12);
+      EXPECT_LT(fmax, 1e-12);
+      EXPECT_LT(xmax, 1e-12);
+    }
 }
