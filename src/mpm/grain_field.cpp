@@ -15,6 +15,57 @@ template <class T>
 void reset(std::vector<T>& v, std::size_t n, const T& value) {
   v.assign(n, value);
 }
+
+// A point whose support lost nodes (weight below the mass cut, node[a] < 0) keeps the
+// reproduction of linear fields by the smallest change of its kept weights and gradients
+// (docs/accuracy.md, "Dropped support nodes"): with r_a = x_a - x_p over the kept nodes,
+// S0 = sum N_a, S1 = sum N_a r_a, S2 = sum N_a r_a r_a^T, g = sum grad N_a, G = sum r_a grad N_a^T,
+//   N'_a = N_a (c + b.r_a):          sum N'_a = 1, sum N'_a r_a = 0 (x_p interpolated exactly),
+//   grad N'_a = grad N_a + N_a (alpha + B r_a):  sum grad N'_a = 0, sum r_a grad N'_a^T = I,
+// i.e. b = -c S2^-1 S1, c = 1 / (S0 - S1.S2^-1 S1); C B^T = I - G + S1 g^T / S0 with
+// C = S2 - S1 S1^T / S0, alpha = -(g + B S1) / S0. False (nothing changed) when the kept nodes
+// do not span the space (C or S2 singular: a linear-shape point on a grid line), where the
+// caller keeps only sum grad N = 0.
+template <class Shape, int Dim>
+bool restore_linear_completeness(double* N, Vec<Dim>* dN, const std::int32_t* node,
+                                 const IVec<Dim>& first, const grid::Grid<Dim>& grid,
+                                 const Vec<Dim>& xp) {
+  constexpr int K = Shape::K;
+  Vec<Dim> r[K];
+  double S0 = 0;
+  Vec<Dim> S1 = Vec<Dim>::Zero(), g = Vec<Dim>::Zero();
+  Mat<Dim> S2 = Mat<Dim>::Zero(), G = Mat<Dim>::Zero();
+  for (int a = 0; a < K; ++a) {
+    if (node[a] < 0) continue;
+    IVec<Dim> c = first;
+    for (int d = 0; d < Dim; ++d) c[d] += Shape::offset(a, d);
+    r[a] = grid.node_position(c) - xp;
+    S0 += N[a];
+    S1 += N[a] * r[a];
+    S2 += N[a] * r[a] * r[a].transpose();
+    g += dN[a];
+    G += r[a] * dN[a].transpose();
+  }
+  const Mat<Dim> C = S2 - S1 * S1.transpose() / S0;
+  const double h2 = grid.cell_size() * grid.cell_size();
+  // Both moment matrices must be well conditioned on the scale of a cell (h^2 times the weight).
+  const Eigen::SelfAdjointEigenSolver<Mat<Dim>> eC(C, Eigen::EigenvaluesOnly);
+  const Eigen::SelfAdjointEigenSolver<Mat<Dim>> e2(S2, Eigen::EigenvaluesOnly);
+  if (!(eC.eigenvalues()[0] > 1e-6 * h2 * S0) || !(e2.eigenvalues()[0] > 1e-6 * h2 * S0))
+    return false;
+  const Mat<Dim> Bt = C.ldlt().solve(Mat<Dim>::Identity() - G + S1 * g.transpose() / S0);
+  const Mat<Dim> B = Bt.transpose();
+  const Vec<Dim> alpha = -(g + B * S1) / S0;
+  const Vec<Dim> s2s1 = S2.ldlt().solve(S1);
+  const double c = 1.0 / (S0 - S1.dot(s2s1));
+  const Vec<Dim> b = -c * s2s1;
+  for (int a = 0; a < K; ++a) {
+    if (node[a] < 0) continue;
+    dN[a] += N[a] * (alpha + B * r[a]);
+    N[a] *= c + b.dot(r[a]);
+  }
+  return true;
+}
 }  // namespace
 
 template <class S1, int Dim>
@@ -184,7 +235,9 @@ void p2g(GrainField<Dim>& w, const grid::Grid<Dim>& grid, const Settings<Dim>& s
       g_sum += w.pt_dN[i * K + a];
       n_sum += w.pt_N[i * K + a];
     }
-    if (dropped && n_sum > 0)
+    if (dropped && n_sum > 0 &&
+        !restore_linear_completeness<Shape, Dim>(&w.pt_N[i * K], &w.pt_dN[i * K], &w.pt_node[i * K],
+                                                 base + lo, grid, points.x[gr.begin + i]))
       for (int a = 0; a < K; ++a)
         if (w.pt_node[i * K + a] >= 0) w.pt_dN[i * K + a] -= (w.pt_N[i * K + a] / n_sum) * g_sum;
   }

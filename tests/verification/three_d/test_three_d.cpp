@@ -1,0 +1,270 @@
+// The MPM step in 3D (issue 18), through the same solver as 2D (ImplicitSolver<3>): homogeneous
+// states with the whole grid driven by a prescribed affine velocity field against the closed form
+// of the compressible Neo-Hookean law (method.md §3, σ = [μ(B − I) + λ ln J I]/J, 1e-8), a full
+// turn about an oblique axis (J = 1 and σ = 0 to round-off), a sphere resting on a wall (mean
+// force = weight) and the head-on impact of two spheres (momentum to round-off, separation).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <numbers>
+#include <vector>
+
+#include "mpmcd/materials/law.hpp"
+#include "mpmcd/mpm/model.hpp"
+#include "mpmcd/mpm/solver.hpp"
+#include "mpmcd/points/seeding.hpp"
+
+using namespace mpmcd;
+
+namespace {
+
+// The paper's gel (method.md §3): Lamé coefficients [Pa], density [kg/m^3], P-wave speed [m/s].
+constexpr double kLambda = 3e6, kMu = 1.5e6, kRho = 990.0;
+const double kCp = std::sqrt((kLambda + 2 * kMu) / kRho);
+
+// A 3D model on the grid [0, n h]^3 with the Neo-Hookean gel.
+mpm::Model<3> make_model(double h, int n) {
+  mpm::Model<3> m;
+  m.grid = grid::Grid<3>(Vec<3>::Zero(), h, IVec<3>(n, n, n));
+  m.add_material(materials::make_law<3>("neo_hookean", {{"lambda", kLambda}, {"mu", kMu}}), kRho);
+  return m;
+}
+
+// A box grain [lo, hi] with ppc^3 points per cell.
+void add_box(mpm::Model<3>& m, const Vec<3>& lo, const Vec<3>& hi, int ppc) {
+  const double h = m.grid.cell_size();
+  m.add_grain(points::seed_box<3>(m.grid.origin(), h, ppc, lo, hi), 0, 0.5 * h / ppc, {});
+}
+
+// A ball grain with ppc^3 points per cell and initial velocity v(x) [m/s].
+void add_ball(mpm::Model<3>& m, const Vec<3>& c, double r, int ppc,
+              const std::function<Vec<3>(const Vec<3>&)>& v = {}) {
+  const double h = m.grid.cell_size();
+  m.add_grain(points::seed_ball<3>(m.grid.origin(), h, ppc, c, r), 0, 0.5 * h / ppc, v);
+}
+
+// Drives every node with du = (dF - I)(x - c) per step (theta = 1, v = du / dt), n steps.
+void drive(mpm::Model<3>& model, grid::ShapeKind shape, const Mat<3>& dF, const Vec<3>& c,
+           int steps, bool affine = false) {
+  const double dt = 1e-3;
+  mpm::Settings<3> s;
+  s.shape = shape;
+  s.theta = 1.0;
+  s.affine = affine;
+  mpm::ImplicitSolver<3> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
+  mpm::VelocityBC<3> bc;
+  bc.nodes.resize(static_cast<std::size_t>(model.grid.node_count()));
+  for (std::size_t i = 0; i < bc.nodes.size(); ++i) bc.nodes[i] = static_cast<std::int64_t>(i);
+  bc.mask = 0b111;
+  bc.gradient = (dF - Mat<3>::Identity()) / dt;
+  bc.anchor = c;
+  solver.set_boundary_conditions({bc});
+  for (int k = 0; k < steps; ++k) {
+    auto stats = solver.solve_step(dt);
+    ASSERT_TRUE(stats.converged) << stats.failure;
+    solver.commit();
+  }
+}
+
+// Cauchy stress of the compressible Neo-Hookean law in 3D (method.md §3) [Pa].
+Mat<3> closed_form_sigma(const Mat<3>& F) {
+  const double J = F.determinant();
+  return (kMu * (F * F.transpose() - Mat<3>::Identity()) +
+          kLambda * std::log(J) * Mat<3>::Identity()) /
+         J;
+}
+
+// The cube [0.8, 1.6]^3 on a grid of h = 0.1 (2^3 points per cell) driven by dF per step for
+// `steps` steps: every point's F, σ and position against F_total = dF^steps.
+void check_homogeneous(grid::ShapeKind shape, const Mat<3>& dF, int steps) {
+  auto model = make_model(0.1, 24);
+  add_box(model, Vec<3>(0.8, 0.8, 0.8), Vec<3>(1.6, 1.6, 1.6), 2);
+  const Vec<3> c(1.2, 1.2, 1.2);
+  const auto X = model.points.x;
+  drive(model, shape, dF, c, steps);
+  Mat<3> F_total = Mat<3>::Identity();
+  for (int k = 0; k < steps; ++k) F_total = dF * F_total;
+  const Mat<3> sigma_exact = closed_form_sigma(F_total);
+  double worst_sigma = 0, worst_x = 0, worst_F = 0;
+  for (std::size_t p = 0; p < model.points.size(); ++p) {
+    worst_F = std::max(worst_F, (model.points.F[p] - F_total).norm());
+    worst_sigma =
+        std::max(worst_sigma, (model.points.sigma[p] - sigma_exact).norm() / sigma_exact.norm());
+    worst_x = std::max(worst_x, (model.points.x[p] - (c + F_total * (X[p] - c))).norm());
+  }
+  std::printf(
+      "  shape %d, %zu points: max |F - F_exact| = %.3e, max rel. stress error = %.3e, max |x - "
+      "x_exact| = %.3e\n",
+      static_cast<int>(shape), model.points.size(), worst_F, worst_sigma, worst_x);
+  EXPECT_LT(worst_sigma, 1e-8);
+  EXPECT_LT(worst_F, 1e-12);
+  EXPECT_LT(worst_x, 1e-12);
+}
+
+mpm::Settings<3> contact_settings(std::vector<mpm::Wall<3>> walls) {
+  mpm::Settings<3> s;
+  s.theta = 1.0;
+  s.linear_solver = mpm::LinearSolverKind::kLdlt;
+  s.contact.enabled = true;
+  s.contact.walls = std::move(walls);
+  s.contact.friction = {0.0};
+  return s;
+}
+
+// Mean velocity of grain g [m/s].
+Vec<3> grain_velocity(const mpm::Model<3>& m, int g) {
+  Vec<3> p = Vec<3>::Zero();
+  double mass = 0;
+  for (auto i = m.grains[g].begin; i < m.grains[g].end; ++i) {
+    p += m.points.mass[i] * m.points.v[i];
+    mass += m.points.mass[i];
+  }
+  return p / mass;
+}
+
+}  // namespace
+
+// Confined (uniaxial-strain) compression to s = 0.9 in 10 steps and simple shear to γ = 0.2 in 10
+// steps, for linear, uGIMP and CPDI shapes: F, σ and x exact to round-off.
+TEST(ThreeD, HomogeneousStatesMatchTheClosedForm) {
+  const double s_step = std::pow(0.9, 0.1);
+  Mat<3> compress = Mat<3>::Identity();
+  compress(2, 2) = s_step;
+  Mat<3> shear = Mat<3>::Identity();
+  shear(0, 2) = 0.02;
+  for (auto shape : {grid::ShapeKind::kLinear, grid::ShapeKind::kUGimp, grid::ShapeKind::kCpdi}) {
+    check_homogeneous(shape, compress, 10);
+    check_homogeneous(shape, shear, 10);
+  }
+  // σ33 of confined compression at s = 0.9: [μ(s² − 1) + λ ln s]/s (method.md §7, the same
+  // in 3D), −0.66787 MPa; σ11 = σ22 = λ ln s / s = −0.35120 MPa.
+  const Mat<3> S = closed_form_sigma(Eigen::Vector3d(1, 1, 0.9).asDiagonal());
+  EXPECT_NEAR(S(2, 2) / 1e6, -0.66787, 5e-6);
+  EXPECT_NEAR(S(0, 0) / 1e6, -0.35120, 5e-6);
+}
+
+// A ball driven through a full turn about the axis (1, 2, 2)/3 in 72 steps of 5 degrees: every
+// point back at its start with F = I, J = 1 and no stress, to round-off.
+TEST(ThreeD, FullTurnAboutAnObliqueAxisLeavesNoStrain) {
+  for (auto shape : {grid::ShapeKind::kLinear, grid::ShapeKind::kCpdi}) {
+    auto model = make_model(0.1, 24);
+    const Vec<3> c(1.2, 1.2, 1.2);
+    add_ball(model, c, 0.45, 2);
+    const auto X = model.points.x;
+    const int steps = 72;
+    const Mat<3> R =
+        Eigen::AngleAxisd(2 * std::numbers::pi / steps, Vec<3>(1, 2, 2) / 3.0).toRotationMatrix();
+    drive(model, shape, R, c, steps, /*affine=*/true);
+    double smax = 0, xmax = 0, jmax = 0;
+    for (std::size_t p = 0; p < model.points.size(); ++p) {
+      smax = std::max(smax, model.points.sigma[p].cwiseAbs().maxCoeff());
+      xmax = std::max(xmax, (model.points.x[p] - X[p]).norm());
+      jmax = std::max(jmax, std::fabs(model.points.F[p].determinant() - 1.0));
+    }
+    std::printf(
+        "  full turn, shape %d, %zu points: max |sigma| = %.3e Pa, |J - 1| = %.2e, "
+        "position error %.2e\n",
+        static_cast<int>(shape), model.points.size(), smax, jmax, xmax);
+    EXPECT_LT(smax, 1e-8 * kMu);
+    EXPECT_LT(jmax, 1e-12);
+    EXPECT_LT(xmax, 1e-12);
+  }
+}
+
+// A sphere (R = 1.5 mm, h = 0.5 mm, 912 points) set on a frictionless wall under
+// gravity: the impulse balance (wall impulses − weight × T = momentum change) holds to round-off,
+// and once the bouncing has been damped by backward Euler the mean wall force is the weight
+// within 1 % (issue 18).
+TEST(ThreeD, SphereRestingOnAWallCarriesItsWeight) {
+  const double h = 0.5e-3, R = 1.5e-3, z_wall = 2 * h;
+  auto model = make_model(h, 10);
+  add_ball(model, Vec<3>(2.5e-3, 2.5e-3, z_wall + R), R, 2);
+  auto s = contact_settings(
+      {{"bottom", Vec<3>(0.0, 0.0, z_wall), Vec<3>(0.0, 0.0, 1.0), Vec<3>::Zero(), 0.0}});
+  s.gravity = Vec<3>(0.0, 0.0, -9.81);
+  mpm::ImplicitSolver<3> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
+  const double dt = 2 * h / kCp, T = 0.008;
+  const int steps = static_cast<int>(T / dt);
+  const double weight = mpm::diagnostics(model).mass * 9.81;
+  const Vec<3> p0 = mpm::diagnostics(model).momentum;
+  double impulse_sum = 0, late_impulse = 0, late_time = 0;
+  for (int k = 0; k < steps; ++k) {
+    solver.set_time(k * dt);
+    auto st = solver.solve_step(dt);
+    ASSERT_TRUE(st.converged) << "step " << k << ": " << st.failure;
+    solver.commit();
+    const double wall_on_grain = -st.wall_force[0][2];  // the wall's reaction on the sphere [N]
+    impulse_sum += wall_on_grain * dt;
+    if (k >= steps / 2) {
+      late_impulse += wall_on_grain * dt;
+      late_time += dt;
+    }
+  }
+  const Vec<3> p1 = mpm::diagnostics(model).momentum;
+  const double balance = impulse_sum - weight * steps * dt - (p1[2] - p0[2]);
+  std::printf(
+      "  %zu points, %d steps of %.3e s: momentum balance residual %.2e (weight x T = %.3e N "
+      "s); wall force / weight over the second half %.5f\n",
+      model.points.size(), steps, dt, balance, weight * steps * dt,
+      late_impulse / late_time / weight);
+  EXPECT_LT(std::abs(balance), 1e-9 * weight * steps * dt);
+  EXPECT_NEAR(late_impulse / late_time / weight, 1.0, 0.01);
+}
+
+// Two spheres (R = 1.5 mm, h = 0.5 mm) at ±1 m/s head on: total momentum conserved to round-off,
+// they separate, no material interpenetration beyond half a cell, energy not created.
+TEST(ThreeD, HeadOnImpactOfTwoSpheresConservesMomentumAndSeparates) {
+  const double h = 0.5e-3, R = 1.5e-3, v0 = 1.0;
+  mpm::Model<3> model;
+  model.grid = grid::Grid<3>(Vec<3>::Zero(), h, IVec<3>(24, 12, 12));  // 12 x 6 x 6 mm
+  model.add_material(materials::make_law<3>("neo_hookean", {{"lambda", kLambda}, {"mu", kMu}}),
+                     kRho);
+  const double xa = 6e-3 - R - h, xb = 6e-3 + R + h, y = 3e-3, z = 3e-3;
+  add_ball(model, Vec<3>(xa, y, z), R, 2, [&](const Vec<3>&) { return Vec<3>(v0, 0, 0); });
+  add_ball(model, Vec<3>(xb, y, z), R, 2, [&](const Vec<3>&) { return Vec<3>(-v0, 0, 0); });
+  auto s = contact_settings({});
+  mpm::ImplicitSolver<3> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
+  const double dt = 0.5 * h / kCp;
+  const auto d0 = mpm::diagnostics(model);
+  const double p_one = 0.5 * d0.mass * v0;
+  double worst_p = 0, min_gap = 1e9, e_max = 0;
+  bool touched = false;
+  int k = 0;
+  for (; k < 2000; ++k) {
+    solver.set_time(k * dt);
+    auto st = solver.solve_step(dt);
+    ASSERT_TRUE(st.converged) << "step " << k << ": " << st.failure;
+    solver.commit();
+    touched = touched || st.active_contacts > 0;
+    const auto d = mpm::diagnostics(model);
+    worst_p = std::max(worst_p, (d.momentum - d0.momentum).norm() / p_one);
+    e_max = std::max(e_max, d.kinetic + d.elastic);
+    double right_a = -1e9, left_b = 1e9;
+    for (auto i = model.grains[0].begin; i < model.grains[0].end; ++i)
+      right_a = std::max(right_a, model.points.x[i][0] + model.grains[0].half_width *
+                                                             std::abs(model.points.F[i](0, 0)));
+    for (auto i = model.grains[1].begin; i < model.grains[1].end; ++i)
+      left_b = std::min(left_b, model.points.x[i][0] -
+                                    model.grains[1].half_width * std::abs(model.points.F[i](0, 0)));
+    min_gap = std::min(min_gap, left_b - right_a);
+    if (touched && st.active_contacts == 0 && grain_velocity(model, 0)[0] < 0 &&
+        grain_velocity(model, 1)[0] > 0)
+      break;
+  }
+  const auto d1 = mpm::diagnostics(model);
+  const double va = grain_velocity(model, 0)[0], vb = grain_velocity(model, 1)[0];
+  std::printf(
+      "  %zu points; separated after %d steps: v_A = %.4f, v_B = %.4f m/s; momentum drift %.2e "
+      "of one sphere's; deepest overlap %.3f cells; energy kept %.1f %%\n",
+      model.points.size(), k, va, vb, worst_p, -min_gap / h,
+      100 * (d1.kinetic + d1.elastic) / (d0.kinetic + d0.elastic));
+  EXPECT_TRUE(touched);
+  EXPECT_LT(k, 2000) << "the spheres did not separate";
+  EXPECT_LT(va, 0.0);
+  EXPECT_GT(vb, 0.0);
+  EXPECT_LT(worst_p, 1e-12);
+  EXPECT_GT(min_gap, -0.5 * h) << "interpenetration beyond half a cell";
+  EXPECT_LE(d1.kinetic + d1.elastic, e_max * (1 + 1e-9));
+}
