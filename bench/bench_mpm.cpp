@@ -3,9 +3,14 @@
 // (R = 0.5 mm, h = R/4, 2x2 points per cell, dt = 0.1 us), at 10k and 100k points, 1 and 2 threads,
 // with the sparse direct (LDLT) and the Jacobi-CG per-grain solvers; "accurate" = 1 runs the
 // large-deformation options (CPDI shape functions, affine P2G, modified Newton: docs/accuracy.md).
+// BM_ImplicitStep3D: the same step in 3D (issue 18) on spheres of ~1,000 points (R = 0.5 mm,
+// h = R/3, 2^3 points per cell), with the memory per point (heap in use after building the model
+// and taking a first step, minus before, over the points: points, grid fields, factorisations).
 //   ./build/release/bench/bench_mpm --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 #include <omp.h>
+
+#include <malloc.h>
 
 #include <cmath>
 
@@ -78,7 +83,77 @@ void BM_ImplicitStep(benchmark::State& state) {
       benchmark::Counter(np, benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// Heap bytes in use by this process [bytes] (glibc mallinfo2: small blocks plus mmapped ones).
+double heap_bytes() {
+  const struct mallinfo2 mi = mallinfo2();
+  return static_cast<double>(mi.uordblks + mi.hblkhd);
+}
+
+mpm::Model<3> make_spheres(std::int64_t target_points) {
+  const double R = 0.5e-3, h = R / 3, pitch = 2.4 * R;
+  const int ppc = 2;
+  const auto per_ball = static_cast<double>(
+      points::seed_ball<3>(Vec<3>::Zero(), h, ppc, Vec<3>::Constant(R + 2 * h), R).x.size());
+  const auto nballs = static_cast<int>(std::ceil(static_cast<double>(target_points) / per_ball));
+  const int n = static_cast<int>(std::ceil(std::cbrt(nballs)));
+  mpm::Model<3> m;
+  const auto cells = static_cast<std::int64_t>(std::ceil((n * pitch + 4 * h) / h));
+  m.grid = grid::Grid<3>(Vec<3>::Zero(), h, IVec<3>(cells, cells, cells));
+  m.add_material(materials::make_law<3>("neo_hookean", {{"lambda", 3e6}, {"mu", 1.5e6}}), 990.0);
+  for (int k = 0; k < nballs; ++k) {
+    const Vec<3> c(2 * h + (k % n + 0.5) * pitch, 2 * h + ((k / n) % n + 0.5) * pitch,
+                   2 * h + (k / (n * n) + 0.5) * pitch);
+    // the compressive, shearing velocity field of the 2D case, with a third component
+    m.add_grain(points::seed_ball<3>(m.grid.origin(), h, ppc, c, R), 0, 0.5 * h / ppc,
+                [&](const Vec<3>& x) {
+                  const Vec<3> r = x - c;
+                  return Vec<3>(-200.0 * r[0] + 100.0 * r[1], -300.0 * r[1], -100.0 * r[2]);
+                });
+  }
+  return m;
+}
+
+void BM_ImplicitStep3D(benchmark::State& state) {
+  const auto target = state.range(0);
+  const int threads = static_cast<int>(state.range(1));
+  omp_set_num_threads(threads);
+  const double heap0 = heap_bytes();
+  auto model = make_spheres(target);
+  mpm::Settings<3> s;
+  s.theta = 1.0;
+  s.linear_solver = mpm::LinearSolverKind::kLdlt;
+  if (state.range(2) != 0) {
+    s.shape = grid::ShapeKind::kCpdi;
+    s.affine = true;
+  }
+  mpm::ImplicitSolver<3> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
+  const double np = static_cast<double>(model.points.size());
+  solver.solve_step(1e-7);
+  solver.commit();
+  const double bytes = heap_bytes() - heap0;
+  std::int64_t iterations = 0, steps = 0;
+  for (auto _ : state) {
+    auto st = solver.solve_step(1e-7);
+    if (!st.converged) state.SkipWithError(st.failure.c_str());
+    solver.commit();
+    iterations += st.iterations;
+    ++steps;
+  }
+  state.counters["points"] = np;
+  state.counters["grains"] = static_cast<double>(model.grains.size());
+  state.counters["newton_it"] = static_cast<double>(iterations) / static_cast<double>(steps);
+  state.counters["bytes/point"] = bytes / np;
+  state.counters["step_pts/s"] =
+      benchmark::Counter(np, benchmark::Counter::kIsIterationInvariantRate);
+}
+
 }  // namespace
+
+BENCHMARK(BM_ImplicitStep3D)
+    ->ArgNames({"points", "threads", "accurate"})
+    ->ArgsProduct({{10000}, {1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 BENCHMARK(BM_ImplicitStep)
     ->ArgNames({"points", "threads", "solver", "accurate"})
