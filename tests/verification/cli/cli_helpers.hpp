@@ -1,5 +1,6 @@
-// What the command-line tests (test_cli*.cpp) share: the example they run, their scratch folders,
-// a one-grain input written from its grain and time sections, a folder's file names.
+// What the command-line tests (test_cli*.cpp) share: running mpmcd (Result, run), the example
+// they run, their scratch folders, a one-grain input written from its grain and time sections, a
+// folder's file names. A test file takes them all with `using namespace mpmcd::test_support::cli`.
 #pragma once
 #include <algorithm>
 #include <filesystem>
@@ -11,6 +12,10 @@
 #include "../../support/scratch.hpp"
 
 namespace mpmcd::test_support::cli {
+
+namespace fs = std::filesystem;
+using test_support::Result;
+using test_support::run;
 
 // The squeezed-disk example's input.
 inline std::string example() {

@@ -19,17 +19,7 @@
 
 #include "cli_helpers.hpp"
 
-namespace fs = std::filesystem;
-
-namespace {
-
-using mpmcd::test_support::Result;
-using mpmcd::test_support::run;
-using mpmcd::test_support::cli::names_in;
-using mpmcd::test_support::cli::scratch;
-using mpmcd::test_support::cli::write_input;
-
-}  // namespace
+using namespace mpmcd::test_support::cli;
 
 // Issue 17: a reused output folder never mixes two runs. A folder holding a run (input.toml or
 // files named after the run) is refused with exit 2 and left as it is; --overwrite removes that

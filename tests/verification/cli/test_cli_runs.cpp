@@ -17,17 +17,7 @@
 
 #include "cli_helpers.hpp"
 
-namespace fs = std::filesystem;
-
-namespace {
-
-using mpmcd::test_support::Result;
-using mpmcd::test_support::run;
-using mpmcd::test_support::cli::example;
-using mpmcd::test_support::cli::scratch;
-using mpmcd::test_support::cli::write_input;
-
-}  // namespace
+using namespace mpmcd::test_support::cli;
 
 TEST(Cli, RunWritesSeriesCsvAndStampedInputCopy) {
   const fs::path dir = scratch("run");
