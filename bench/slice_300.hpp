@@ -10,13 +10,14 @@
 #include "mpmcd/mpm/solver.hpp"
 #include "mpmcd/packing/packing.hpp"
 #include "mpmcd/packing/seeding.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace mpmcd::bench {
 
 /// The model and its four walls.
 struct Slice {
-  mpm::Model<2> model;              ///< grid, material, 300 grains
-  std::vector<mpm::Wall<2>> walls;  ///< bottom, top (moving down at 2 m/s), left, right
+  mpm::Model<2> model;                ///< grid, material, 300 grains
+  std::vector<walls::Wall<2>> walls;  ///< bottom, top (moving down at 2 m/s), left, right
 };
 
 /// Builds the slice (about 1 s: the DEM packing and the seeding).

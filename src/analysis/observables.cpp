@@ -19,7 +19,7 @@ bool near(double a, double b) {
 
 }  // namespace
 
-std::optional<BoxWalls> find_box(std::span<const Plane> walls) {
+std::optional<BoxWalls> find_box(std::span<const walls::Wall<2>> walls) {
   if (walls.size() != 4) return std::nullopt;
   int found[4] = {-1, -1, -1, -1};  // left, right, bottom, top
   for (std::size_t k = 0; k < walls.size(); ++k) {
@@ -40,15 +40,12 @@ std::optional<BoxWalls> find_box(std::span<const Plane> walls) {
   return b;
 }
 
-Box box_at(std::span<const Plane> walls, const BoxWalls& b, double t) {
-  auto at = [&](std::size_t k, int axis) {
-    return walls[k].point[axis] + (t - walls[k].t0) * walls[k].velocity[axis];
-  };
+Box box_at(std::span<const walls::Wall<2>> walls, const BoxWalls& b, double t) {
   Box box;
-  box.x_min = at(b.left, 0);
-  box.x_max = at(b.right, 0);
-  box.y_min = at(b.bottom, 1);
-  box.y_max = at(b.top, 1);
+  box.x_min = walls[b.left].point_at(t)[0];
+  box.x_max = walls[b.right].point_at(t)[0];
+  box.y_min = walls[b.bottom].point_at(t)[1];
+  box.y_max = walls[b.top].point_at(t)[1];
   return box;
 }
 

@@ -43,10 +43,7 @@ Vec<2> force_on(const mpm::StepStats& step, std::size_t k) {
 }  // namespace
 
 CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Model<2>& model)
-    : config_(config) {
-  for (const auto& w : config.walls)
-    walls_.push_back({Vec<2>(w.point.at(0), w.point.at(1)), Vec<2>(w.normal.at(0), w.normal.at(1)),
-                      Vec<2>(w.velocity.at(0), w.velocity.at(1))});
+    : config_(config), walls_(input_walls(config)) {
   box_ = analysis::find_box(walls_);
   if (box_) box0_ = analysis::box_at(walls_, *box_, 0.0);
   vs0_ = reference_grain_area(model);
@@ -72,9 +69,8 @@ CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Mode
         "walls with normals +x, -x, +y, -y)");
 }
 
-void CompactionObserver::move_walls(const std::vector<mpm::Wall<2>>& walls) {
-  for (std::size_t k = 0; k < walls_.size() && k < walls.size(); ++k)
-    walls_[k] = {walls[k].point, walls[k].normal, walls[k].velocity, walls[k].t0};
+void CompactionObserver::move_walls(const std::vector<walls::Wall<2>>& walls) {
+  for (std::size_t k = 0; k < walls_.size() && k < walls.size(); ++k) walls_[k] = walls[k];
 }
 
 std::string CompactionObserver::csv_header() const {

@@ -20,7 +20,7 @@ EnergySums EnergyLedger<Dim>::start(std::size_t walls, const mpm::Diagnostics<Di
 
 template <int Dim>
 void EnergyLedger<Dim>::add_step(const mpm::StepStats& step,
-                                 const std::vector<mpm::Wall<Dim>>& walls, double dt) {
+                                 const std::vector<walls::Wall<Dim>>& walls, double dt) {
   auto& s = sums_;
   double step_work = 0;
   for (std::size_t k = 0; k < s.wall_work.size() && k < step.wall_force.size(); ++k) {

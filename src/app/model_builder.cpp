@@ -260,6 +260,13 @@ bool contact_enabled(const io::Config& cfg, std::size_t grains) {
   return cfg.contact.enabled && (grains > 1 || !cfg.walls.empty());
 }
 
+std::vector<walls::Wall<2>> input_walls(const io::Config& cfg) {
+  std::vector<walls::Wall<2>> out;
+  for (const auto& w : cfg.walls)
+    out.push_back({w.name, vec2(w.point), vec2(w.normal), vec2(w.velocity), w.friction});
+  return out;
+}
+
 mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& model) {
   mpm::Settings<2> s;
   s.shape = grid::shape_kind_from_string(cfg.grid.shape_function);
@@ -310,8 +317,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
     const int a = index(p.materials[0]), b = index(p.materials[1]);
     c.friction[a * nm + b] = c.friction[b * nm + a] = p.friction;
   }
-  for (const auto& w : cfg.walls)
-    c.walls.push_back({w.name, vec2(w.point), vec2(w.normal), vec2(w.velocity), w.friction});
+  c.walls = input_walls(cfg);
   // The active-set solver solves the normal impulses only: refuse friction rather than drop it.
   if (c.active_set) {
     const auto refuse = [&](std::int64_t line, const std::string& where) {

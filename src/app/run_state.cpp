@@ -113,7 +113,7 @@ void for_each_energy_field(F&& f) {
 template <int Dim>
 void store_run(const io::Config& cfg, const mpm::Model<Dim>& model,
                const std::vector<mpm::WarmImpulse<Dim>>& warm,
-               const std::vector<mpm::Wall<Dim>>& walls, checkpoint::State& s) {
+               const std::vector<walls::Wall<Dim>>& walls, checkpoint::State& s) {
   s.dim = Dim;
   s.input_text = cfg.source_text;
   s.input_path = cfg.source_path;
@@ -262,7 +262,7 @@ mpm::Model<Dim> restore_model(const io::Config& cfg, const checkpoint::State& s,
 
 template void store_run<2>(const io::Config&, const mpm::Model<2>&,
                            const std::vector<mpm::WarmImpulse<2>>&,
-                           const std::vector<mpm::Wall<2>>&, checkpoint::State&);
+                           const std::vector<walls::Wall<2>>&, checkpoint::State&);
 template mpm::Model<2> restore_model<2>(const io::Config&, const checkpoint::State&,
                                         const std::string&);
 template std::vector<mpm::WarmImpulse<2>> warm_start_of<2>(const checkpoint::State&);

@@ -29,13 +29,11 @@ double WallProgram::share(double t) const {
   return std::clamp((t - t_start) / ramp, 0.0, 1.0);
 }
 
-WallLoading::WallLoading(const io::Config& config, const std::vector<mpm::Wall<2>>& walls,
+WallLoading::WallLoading(const io::Config& config, const std::vector<walls::Wall<2>>& walls,
                          const mpm::Model<2>& model)
     : active_(config.loading.present), section_(&config.loading), walls0_(walls) {
-  std::vector<analysis::Plane> p;
-  for (const auto& w : walls) p.push_back({w.point, w.normal, w.velocity, w.t0});
-  box_ = analysis::find_box(p);
-  if (box_) box0_ = analysis::box_at(p, *box_, 0.0);
+  box_ = analysis::find_box(walls);
+  if (box_) box0_ = analysis::box_at(walls, *box_, 0.0);
   eps_time_ = 1e-9 * config.time.dt;
   const std::size_t nw = walls.size();
   state_.programs.assign(nw, WallProgram{});
@@ -94,17 +92,14 @@ std::string WallLoading::describe() const {
       integral_time_ > 0 ? fmt::format(", integral time {:.6g} s", integral_time_) : "");
 }
 
-std::vector<analysis::Plane> WallLoading::planes() const {
-  std::vector<analysis::Plane> p;
-  for (std::size_t k = 0; k < walls0_.size(); ++k)
-    p.push_back({state_.position[k], walls0_[k].normal, Vec<2>::Zero(), 0.0});
-  return p;
+analysis::Box WallLoading::box_now() const {
+  // walls(t) anchors each wall at its current position at time t: the box at that same t.
+  return analysis::box_at(walls(0.0), *box_, 0.0);
 }
 
 double WallLoading::measured_stress(std::size_t k) const {
   if (!box_) return 0.0;
-  const auto p = planes();
-  const analysis::Box box = analysis::box_at(p, *box_, 0.0);
+  const analysis::Box box = box_now();
   // sigma = F.n / L (docs/observables.md), F the force of the grains on the wall in the last
   // step (mpm::StepStats::wall_force), L the wall's length between its neighbours.
   return analysis::wall_normal_stress(state_.force[k], walls0_[k].normal,
@@ -113,8 +108,7 @@ double WallLoading::measured_stress(std::size_t k) const {
 
 analysis::CompactionState WallLoading::compaction(double grain_area) const {
   if (!box_) return {};
-  const auto p = planes();
-  return analysis::compaction_state(analysis::box_at(p, *box_, 0.0), box0_, grain_area, vs0_);
+  return analysis::compaction_state(box_now(), box0_, grain_area, vs0_);
 }
 
 void WallLoading::start(double grain_area) {
@@ -163,8 +157,8 @@ void WallLoading::begin_stage(std::size_t k, double t, double grain_area) {
   }
 }
 
-std::vector<mpm::Wall<2>> WallLoading::step_walls(double t, double dt) {
-  std::vector<mpm::Wall<2>> out = walls0_;
+std::vector<walls::Wall<2>> WallLoading::step_walls(double t, double dt) {
+  std::vector<walls::Wall<2>> out = walls0_;
   for (std::size_t k = 0; k < out.size(); ++k) {
     const WallProgram& prog = state_.programs[k];
     Vec<2> v = prog.velocity_at(t + dt);
@@ -250,8 +244,8 @@ std::optional<std::string> WallLoading::advance(double t, double grain_area) {
   return line;
 }
 
-std::vector<mpm::Wall<2>> WallLoading::walls(double t) const {
-  std::vector<mpm::Wall<2>> out = walls0_;
+std::vector<walls::Wall<2>> WallLoading::walls(double t) const {
+  std::vector<walls::Wall<2>> out = walls0_;
   for (std::size_t k = 0; k < out.size(); ++k) {
     out[k].point = state_.position[k];
     out[k].t0 = t;

@@ -226,7 +226,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
     for (std::int64_t k = 0; k < npairs; ++k) {
       const std::size_t wi = static_cast<std::size_t>(k) / nlocal;
       const std::size_t g = local_[static_cast<std::size_t>(k) % nlocal];
-      const Wall<Dim>& wall = cs.walls[wi];
+      const walls::Wall<Dim>& wall = cs.walls[wi];
       const GrainWork& w = *work_[g];
       for (std::size_t a = 0; a < w.m.size(); ++a) {
         if (w.m[a] < w.contact_mass) continue;
@@ -256,7 +256,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
     }
   }
   for (std::size_t wi = 0; wi < cs.walls.size(); ++wi) {
-    const Wall<Dim>& wall = cs.walls[wi];
+    const walls::Wall<Dim>& wall = cs.walls[wi];
     for (std::size_t li = 0; li < nlocal; ++li) {
       const std::size_t g = local_[li];
       if (cs.wall_points) {

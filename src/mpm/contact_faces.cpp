@@ -318,7 +318,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
     double speed = 0;
     for (const auto& w : work_)
       for (const Vec<Dim>& v : w->v) speed = std::max(speed, v.norm());
-    for (const Wall<Dim>& wall : cs.walls) speed = std::max(speed, wall.velocity.norm());
+    for (const walls::Wall<Dim>& wall : cs.walls) speed = std::max(speed, wall.velocity.norm());
     speed += settings_.gravity.norm() * dt_;
     cut = std::min(range, cs.gap_horizon * 2.0 * speed * dt_);
   }

@@ -42,7 +42,7 @@ template <int Dim>
 ImplicitSolver<Dim>::~ImplicitSolver() = default;
 
 template <int Dim>
-void ImplicitSolver<Dim>::set_walls(std::vector<Wall<Dim>> walls) {
+void ImplicitSolver<Dim>::set_walls(std::vector<walls::Wall<Dim>> walls) {
   if (walls.size() != settings_.contact.walls.size())
     throw std::logic_error("ImplicitSolver::set_walls: another number of walls");
   settings_.contact.walls = std::move(walls);

@@ -13,17 +13,9 @@
 #include "mpmcd/contact/problem.hpp"
 #include "mpmcd/core/types.hpp"
 #include "mpmcd/points/point_set.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace mpmcd::analysis {
-
-/// A rigid plane wall: the plane through point + velocity (t - t0) with unit normal into the
-/// domain.
-struct Plane {
-  Vec<2> point = Vec<2>::Zero();     ///< a point of the plane at time t0 [m]
-  Vec<2> normal = Vec<2>::Zero();    ///< unit normal into the domain [-]
-  Vec<2> velocity = Vec<2>::Zero();  ///< prescribed velocity [m/s]
-  double t0 = 0.0;                   ///< time at which the plane passes through `point` [s]
-};
 
 /// Which of the walls bound an axis-aligned rectangular box (indices into the wall list).
 struct BoxWalls {
@@ -47,10 +39,10 @@ struct Box {
 
 /// The four walls form a box when there are exactly four and their normals are +x, -x, +y, -y
 /// (each component within 1e-12 of 0 or ±1); nullopt otherwise.
-std::optional<BoxWalls> find_box(std::span<const Plane> walls);
+std::optional<BoxWalls> find_box(std::span<const walls::Wall<2>> walls);
 
-/// The box bounded by the walls at time t [s]: each wall at point + velocity (t - t0).
-Box box_at(std::span<const Plane> walls, const BoxWalls& box, double t);
+/// The box bounded by the walls at time t [s]: each wall at walls::Wall::point_at(t).
+Box box_at(std::span<const walls::Wall<2>> walls, const BoxWalls& box, double t);
 
 /// Length of wall `k` [m] inside the box: the width for the bottom and top walls, the height for
 /// the left and right walls; 0 if k is not one of the box walls.

@@ -11,6 +11,7 @@
 #include "mpmcd/io/config.hpp"
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace mpmcd::app {
 
@@ -65,7 +66,7 @@ class CompactionObserver {
 
   /// Follows walls whose motion is not their input's constant velocity (app::WallLoading): the
   /// box is then that of `walls` (same order as the input's [[walls]]).
-  void move_walls(const std::vector<mpm::Wall<2>>& walls);
+  void move_walls(const std::vector<walls::Wall<2>>& walls);
 
   /// Replaces V_s0, the grains' area at t = 0 [m^2] (a restarted run must pass the value of the
   /// original start, e.g. from the first CSV row, since the constructor measures the model it is
@@ -84,7 +85,7 @@ class CompactionObserver {
 
  private:
   const io::Config& config_;
-  std::vector<analysis::Plane> walls_;
+  std::vector<walls::Wall<2>> walls_;
   std::optional<analysis::BoxWalls> box_;
   analysis::Box box0_;
   double vs0_ = 0;

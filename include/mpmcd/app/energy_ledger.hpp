@@ -13,6 +13,7 @@
 #include "mpmcd/io/config.hpp"
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace mpmcd::app {
 
@@ -46,7 +47,7 @@ class EnergyLedger {
   explicit EnergyLedger(EnergySums sums) : sums_(std::move(sums)) {}
 
   /// Adds the committed step of length dt [s] with statistics `step` against `walls`.
-  void add_step(const mpm::StepStats& step, const std::vector<mpm::Wall<Dim>>& walls, double dt);
+  void add_step(const mpm::StepStats& step, const std::vector<walls::Wall<Dim>>& walls, double dt);
 
   /// The terms at the committed state of diagnostics `d`.
   EnergyTerms terms(const mpm::Diagnostics<Dim>& d) const;

@@ -9,6 +9,7 @@
 #include "mpmcd/io/config.hpp"
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace mpmcd::app {
 
@@ -32,6 +33,10 @@ std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& config,
 /// True when contact is solved: asked for ([contact] enabled) and there is something to touch
 /// (more than one of the model's `grains`, or a wall).
 bool contact_enabled(const io::Config& config, std::size_t grains);
+
+/// The input's [[walls]] as walls at t = 0 (t0 = 0, the input's velocity), in input order: the one
+/// place an io::WallSection becomes a walls::Wall (the contact settings, the observables' box).
+std::vector<walls::Wall<2>> input_walls(const io::Config& config);
 
 /// Solver settings from the input and its model (the model's grains decide contact_enabled, its
 /// materials' wave speeds the Delassus operator).

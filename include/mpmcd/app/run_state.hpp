@@ -14,6 +14,7 @@
 #include "mpmcd/io/config.hpp"
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace mpmcd::app {
 
@@ -24,7 +25,7 @@ namespace mpmcd::app {
 template <int Dim>
 void store_run(const io::Config& config, const mpm::Model<Dim>& model,
                const std::vector<mpm::WarmImpulse<Dim>>& warm,
-               const std::vector<mpm::Wall<Dim>>& walls, checkpoint::State& state);
+               const std::vector<walls::Wall<Dim>>& walls, checkpoint::State& state);
 
 /// The model of a restart: grid and materials from `config`, points and grains from `state` (no
 /// packing is regenerated). Throws InputError naming `path` if they do not fit together
@@ -50,7 +51,7 @@ EnergySums energy_sums_of(const checkpoint::State& state);
 
 extern template void store_run<2>(const io::Config&, const mpm::Model<2>&,
                                   const std::vector<mpm::WarmImpulse<2>>&,
-                                  const std::vector<mpm::Wall<2>>&, checkpoint::State&);
+                                  const std::vector<walls::Wall<2>>&, checkpoint::State&);
 extern template mpm::Model<2> restore_model<2>(const io::Config&, const checkpoint::State&,
                                                const std::string&);
 extern template std::vector<mpm::WarmImpulse<2>> warm_start_of<2>(const checkpoint::State&);

@@ -18,6 +18,7 @@
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/settings.hpp"
 #include "mpmcd/mpm/solver.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace mpmcd::app {
 
@@ -66,7 +67,7 @@ class WallLoading {
  public:
   /// From the input and the walls at t = 0 (the settings'); `model` gives the grains' density,
   /// P-wave modulus M_p and wave speed for the automatic gain and speed limit.
-  WallLoading(const io::Config& config, const std::vector<mpm::Wall<2>>& walls,
+  WallLoading(const io::Config& config, const std::vector<walls::Wall<2>>& walls,
               const mpm::Model<2>& model);
 
   /// True when the input has [loading].
@@ -82,7 +83,7 @@ class WallLoading {
   void start(double grain_area);
   /// The walls for the step [t, t + dt] [s]: each at its position at t, with the velocity of its
   /// program (a servo's from the last step's force). A retried step calls it again.
-  std::vector<mpm::Wall<2>> step_walls(double t, double dt);
+  std::vector<walls::Wall<2>> step_walls(double t, double dt);
   /// The step [t, t + dt] given by the last step_walls has been committed with statistics `st`:
   /// positions advance, the force is kept for the next servo step.
   void committed(const mpm::StepStats& st, double dt);
@@ -100,7 +101,7 @@ class WallLoading {
   const std::string& stage_name() const;
 
   /// The walls at time t [s] (after a committed step): the planes the outputs measure.
-  std::vector<mpm::Wall<2>> walls(double t) const;
+  std::vector<walls::Wall<2>> walls(double t) const;
 
   /// Extra CSV header, starting with a comma: `stage` and per wall its velocity of the last step
   /// and its target stress ("" when inactive).
@@ -122,11 +123,12 @@ class WallLoading {
   analysis::CompactionState compaction(double grain_area) const;
   // Starts stage `k` at time t [s].
   void begin_stage(std::size_t k, double t, double grain_area);
-  std::vector<analysis::Plane> planes() const;
+  // The box at the walls' current positions.
+  analysis::Box box_now() const;
 
   bool active_ = false;
   const io::LoadingSection* section_ = nullptr;
-  std::vector<mpm::Wall<2>> walls0_;       // the walls at t = 0 (names, normals, friction)
+  std::vector<walls::Wall<2>> walls0_;     // the walls at t = 0 (names, normals, friction)
   std::optional<analysis::BoxWalls> box_;  // which walls bound the box
   analysis::Box box0_;                     // the box at t = 0
   std::vector<std::size_t> until_wall_;    // per stage: index of until.wall (or 0)

@@ -1,6 +1,7 @@
 #pragma once
-/// The inputs of the implicit step: numerical settings, contact settings, rigid walls and nodal
-/// velocity boundary conditions (read by ImplicitSolver and by the grain-field stages).
+/// The inputs of the implicit step: numerical settings, contact settings (with the rigid walls,
+/// walls::Wall) and nodal velocity boundary conditions (read by ImplicitSolver and by the
+/// grain-field stages).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -8,6 +9,7 @@
 #include "mpmcd/contact/problem.hpp"
 #include "mpmcd/core/types.hpp"
 #include "mpmcd/grid/shape.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace mpmcd::mpm {
 
@@ -20,25 +22,6 @@ enum class LinearSolverKind {
 
 /// Parses "ldlt" / "lu" / "cg"; throws InputError otherwise.
 LinearSolverKind linear_solver_from_string(const std::string& name);
-
-/// A rigid wall: the plane through `point` + velocity (t - t0) with unit `normal` pointing into
-/// the domain; it takes part in contact as a body of infinite mass. A wall whose velocity changes
-/// (app::WallLoading: stages, servo) is re-anchored at each step: point = its position at t0 = t^n.
-template <int Dim>
-struct Wall {
-  std::string name;                      ///< name used in outputs
-  Vec<Dim> point = Vec<Dim>::Zero();     ///< a point of the plane at time t0 [m]
-  Vec<Dim> normal = Vec<Dim>::Zero();    ///< unit normal into the domain [-]
-  Vec<Dim> velocity = Vec<Dim>::Zero();  ///< prescribed velocity [m/s]
-  double friction = 0.0;                 ///< Coulomb coefficient with every grain [-]
-  double t0 = 0.0;                       ///< time at which the plane passes through `point` [s]
-  /// Signed distance of x [m] from the wall at time t [s] (positive inside the domain) [m].
-  double distance(const Vec<Dim>& x, double t) const {
-    return (x - point - (t - t0) * velocity).dot(normal);
-  }
-  /// A point of the plane at time t [s] [m].
-  Vec<Dim> point_at(double t) const { return point + (t - t0) * velocity; }
-};
 
 /// When a grain-grain contact switches on (method.md §4).
 enum class GapCriterion {
@@ -55,9 +38,9 @@ struct ContactSettings {
       1e-4;           ///< a field takes part at a node above this fraction of a cell's mass
   int materials = 1;  ///< number of materials (size of the friction matrix)
   std::vector<double> friction = {
-      0.0};                      ///< mu_f per material pair, row-major materials x materials
-  std::vector<Wall<Dim>> walls;  ///< rigid walls
-  double wall_range = 1.0;       ///< grain nodes within this many cells of a wall are candidates
+      0.0};                             ///< mu_f per material pair, row-major materials x materials
+  std::vector<walls::Wall<Dim>> walls;  ///< rigid walls
+  double wall_range = 1.0;  ///< grain nodes within this many cells of a wall are candidates
   /// Where a wall acts (docs/accuracy.md): false = at grain nodes (the node velocity may not
   /// cross the wall), true = at the faces of the points' domains facing the wall (the velocity
   /// of the face, interpolated from the nodes, may not cross it), which holds the material edge,

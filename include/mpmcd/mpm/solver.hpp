@@ -112,7 +112,7 @@ class ImplicitSolver {
   void set_time(double t) { time_ = t; }
   /// Replaces the rigid walls (their positions and velocities for the next step; same count and
   /// order as the settings' walls: a wall's index names it in contacts and forces).
-  void set_walls(std::vector<Wall<Dim>> walls);
+  void set_walls(std::vector<walls::Wall<Dim>> walls);
   /// The contact problem of the last step (impulses solved), for output and replay.
   const contact::Problem<Dim>& contact_problem() const { return problem_; }
   /// Warm-start impulses kept from the last converged step, sorted by (node, a, b).

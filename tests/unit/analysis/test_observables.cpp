@@ -11,6 +11,7 @@
 #include "mpmcd/analysis/observables.hpp"
 #include "mpmcd/analysis/time_series.hpp"
 #include "mpmcd/core/errors.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 using namespace mpmcd;
 using namespace mpmcd::analysis;
@@ -18,11 +19,11 @@ using namespace mpmcd::analysis;
 namespace {
 
 // A 3 mm x 2 mm box at the origin, top wall moving down at 2 m/s, listed in a shuffled order.
-std::vector<Plane> box_walls() {
-  return {{Vec<2>(0, 2e-3), Vec<2>(0, -1), Vec<2>(0, -2)},   // top
-          {Vec<2>(0, 0), Vec<2>(1, 0), Vec<2>::Zero()},      // left
-          {Vec<2>(3e-3, 0), Vec<2>(-1, 0), Vec<2>::Zero()},  // right
-          {Vec<2>(0, 0), Vec<2>(0, 1), Vec<2>::Zero()}};     // bottom
+std::vector<walls::Wall<2>> box_walls() {
+  return {{"top", Vec<2>(0, 2e-3), Vec<2>(0, -1), Vec<2>(0, -2)},
+          {"left", Vec<2>(0, 0), Vec<2>(1, 0), Vec<2>::Zero()},
+          {"right", Vec<2>(3e-3, 0), Vec<2>(-1, 0), Vec<2>::Zero()},
+          {"bottom", Vec<2>(0, 0), Vec<2>(0, 1), Vec<2>::Zero()}};
 }
 
 ContactImpulse pair(int a, int b, double p) {

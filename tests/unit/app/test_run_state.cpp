@@ -17,6 +17,7 @@
 #include "mpmcd/checkpoint/checkpoint.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/io/load_config.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 namespace app = mpmcd::app;
 using mpmcd::Mat;
@@ -62,8 +63,8 @@ std::vector<mpmcd::mpm::WarmImpulse<2>> some_warm_start() {
   return {{5, 0, 1, Vec<2>(1.5, -2.5)}, {-3, -2, 0, Vec<2>(0.25, 0.125)}};
 }
 
-std::vector<mpmcd::mpm::Wall<2>> walls_of(const mpmcd::io::Config& cfg,
-                                          const mpmcd::mpm::Model<2>& model) {
+std::vector<mpmcd::walls::Wall<2>> walls_of(const mpmcd::io::Config& cfg,
+                                            const mpmcd::mpm::Model<2>& model) {
   return app::build_settings(cfg, model).contact.walls;
 }
 
@@ -174,7 +175,7 @@ TEST(EnergyLedger, SumsTheWallsWorkAndClosesOnItsTerms) {
   d0.elastic = 0.0;
   app::EnergyLedger<2> ledger(app::EnergyLedger<2>::start(1, d0));
   EXPECT_TRUE(ledger.active());
-  std::vector<mpmcd::mpm::Wall<2>> walls(1);
+  std::vector<mpmcd::walls::Wall<2>> walls(1);
   walls[0].velocity = Vec<2>(0.0, -2.0);
   mpmcd::mpm::StepStats st;
   st.wall_force = {{0.0, 3.0, 0.0}};  // the grains push the wall up, it moves down: W = 6 dt

@@ -10,6 +10,7 @@
 
 #include "../../support/builders.hpp"
 #include "mpmcd/contact/problem.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 using namespace mpmcd;
 using test_support::add_box;
@@ -22,7 +23,7 @@ using test_support::make_model;
 
 namespace {
 
-mpm::Settings<2> contact_settings(std::vector<mpm::Wall<2>> walls, double friction = 0.0) {
+mpm::Settings<2> contact_settings(std::vector<walls::Wall<2>> walls, double friction = 0.0) {
   mpm::Settings<2> s;
   s.theta = 1.0;
   s.linear_solver = mpm::LinearSolverKind::kLdlt;
@@ -32,7 +33,7 @@ mpm::Settings<2> contact_settings(std::vector<mpm::Wall<2>> walls, double fricti
   return s;
 }
 
-mpm::Wall<2> bottom_wall(double y, double friction = 0.0) {
+walls::Wall<2> bottom_wall(double y, double friction = 0.0) {
   return {"bottom", Vec<2>(0.0, y), Vec<2>(0.0, 1.0), Vec<2>::Zero(), friction};
 }
 
