@@ -15,6 +15,7 @@
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "mpmcd/points/seeding.hpp"
+#include "mpmcd/walls/wall.hpp"
 
 using namespace mpmcd;
 
@@ -103,7 +104,7 @@ void check_homogeneous(grid::ShapeKind shape, const Mat<3>& dF, int steps) {
   EXPECT_LT(worst_x, 1e-12);
 }
 
-mpm::Settings<3> contact_settings(std::vector<mpm::Wall<3>> walls) {
+mpm::Settings<3> contact_settings(std::vector<walls::Wall<3>> walls) {
   mpm::Settings<3> s;
   s.theta = 1.0;
   s.linear_solver = mpm::LinearSolverKind::kLdlt;
