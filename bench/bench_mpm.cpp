@@ -121,7 +121,7 @@ void BM_ImplicitStep3D(benchmark::State& state) {
   auto model = make_spheres(target);
   mpm::Settings<3> s;
   s.theta = 1.0;
-  s.linear_solver = mpm::LinearSolverKind::kLdlt;
+  s.linear_solver = static_cast<mpm::LinearSolverKind>(state.range(3));
   if (state.range(2) != 0) {
     s.shape = grid::ShapeKind::kCpdi;
     s.affine = true;
@@ -150,8 +150,8 @@ void BM_ImplicitStep3D(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_ImplicitStep3D)
-    ->ArgNames({"points", "threads", "accurate"})
-    ->ArgsProduct({{10000}, {1, 2}, {0, 1}})
+    ->ArgNames({"points", "threads", "accurate", "solver"})
+    ->ArgsProduct({{10000}, {1, 2}, {0, 1}, {0, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
