@@ -8,10 +8,12 @@
 #include <numbers>
 
 #include "../../support/builders.hpp"
+#include "../../support/drivers.hpp"
 
 using namespace mpmcd;
 using test_support::add_box;
 using test_support::add_disk;
+using test_support::drive_affine;
 using test_support::kCp;
 using test_support::kLambda;
 using test_support::kMu;
@@ -19,28 +21,6 @@ using test_support::kRho;
 using test_support::make_model;
 
 namespace {
-
-// Drives every node with du = (dF - I)(x - c) per step (theta = 1, so v = du / dt), n steps.
-void drive(mpm::Model<2>& model, grid::ShapeKind shape, const Mat<2>& dF, const Vec<2>& c,
-           int steps, double dt = 1e-3, double flip = 1.0, bool affine = false) {
-  mpm::Settings<2> s;
-  s.shape = shape;
-  s.affine = affine;
-  s.theta = 1.0;
-  s.flip = flip;
-  mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
-  mpm::VelocityBC<2> bc;
-  bc.nodes = test_support::all_nodes(model.grid);
-  bc.mask = 0b11;
-  bc.gradient = (dF - Mat<2>::Identity()) / dt;
-  bc.anchor = c;
-  solver.set_boundary_conditions({bc});
-  for (int k = 0; k < steps; ++k) {
-    auto stats = solver.solve_step(dt);
-    ASSERT_TRUE(stats.converged) << stats.failure;
-    solver.commit();
-  }
-}
 
 Mat<2> closed_form_sigma(const Mat<2>& F) {
   const double J = F.determinant();
@@ -54,15 +34,10 @@ void check_homogeneous(grid::ShapeKind shape, const Mat<2>& F_total, const Mat<2
   add_box(model, Vec<2>(1.0, 1.0), Vec<2>(2.0, 2.0), 2);
   const Vec<2> c(1.5, 1.5);
   const auto X = model.points.x;
-  drive(model, shape, dF, c, steps);
+  drive_affine(model, shape, dF, c, steps);
   const Mat<2> sigma_exact = closed_form_sigma(F_total);
-  double worst_sigma = 0, worst_x = 0, worst_F = 0;
-  for (std::size_t p = 0; p < model.points.size(); ++p) {
-    worst_F = std::max(worst_F, (model.points.F[p] - F_total).norm());
-    worst_sigma =
-        std::max(worst_sigma, (model.points.sigma[p] - sigma_exact).norm() / sigma_exact.norm());
-    worst_x = std::max(worst_x, (model.points.x[p] - (c + F_total * (X[p] - c))).norm());
-  }
+  const auto err = test_support::homogeneous_error(model, X, c, F_total, sigma_exact);
+  const double worst_F = err.F, worst_sigma = err.sigma, worst_x = err.x;
   std::printf(
       "  max |F - F_exact| = %.3e, max rel. stress error = %.3e, max |x - x_exact| = %.3e m\n",
       worst_F, worst_sigma, worst_x);
@@ -108,7 +83,7 @@ TEST(Kinematics, AffineVelocityFieldReproducedExactly) {
     dF << 1.01, 0.02, -0.015, 0.995;
     const Vec<2> c(1.5, 1.5);
     const auto X = model.points.x;
-    drive(model, shape, dF, c, 1, dt, /*flip=*/0.0);
+    drive_affine(model, shape, dF, c, 1, dt, /*flip=*/0.0);
     const Mat<2> L = (dF - Mat<2>::Identity()) / dt;
     double ex = 0, ev = 0, eF = 0;
     for (std::size_t p = 0; p < model.points.size(); ++p) {
@@ -135,7 +110,7 @@ TEST(Kinematics, RigidRotationBy90DegreesCreatesNoStress) {
     const double a = std::numbers::pi / 2 / steps;
     Mat<2> R;
     R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-    drive(model, shape, R, c, steps);
+    drive_affine(model, shape, R, c, steps);
     Mat<2> R90;
     R90 << 0, -1, 1, 0;
     double smax = 0, xmax = 0;
@@ -167,7 +142,7 @@ TEST(Kinematics, FullTurnBringsEveryPointBackUnstrained) {
       const double a = 2 * std::numbers::pi / steps;
       Mat<2> R;
       R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-      drive(model, shape, R, c, steps, 1e-3, 1.0, affine);
+      drive_affine(model, shape, R, c, steps, 1e-3, 1.0, affine);
       double smax = 0, xmax = 0, jmax = 0, fmax = 0;
       for (std::size_t p = 0; p < model.points.size(); ++p) {
         smax = std::max(smax, model.points.sigma[p].cwiseAbs().maxCoeff());

@@ -12,6 +12,7 @@
 #include <numbers>
 #include <vector>
 
+#include "../../support/drivers.hpp"
 #include "mpmcd/materials/law.hpp"
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
@@ -47,29 +48,6 @@ void add_ball(mpm::Model<3>& m, const Vec<3>& c, double r, int ppc,
   m.add_grain(points::seed_ball<3>(m.grid.origin(), h, ppc, c, r), 0, 0.5 * h / ppc, v);
 }
 
-// Drives every node with du = (dF - I)(x - c) per step (theta = 1, v = du / dt), n steps.
-void drive(mpm::Model<3>& model, grid::ShapeKind shape, const Mat<3>& dF, const Vec<3>& c,
-           int steps, bool affine = false) {
-  const double dt = 1e-3;
-  mpm::Settings<3> s;
-  s.shape = shape;
-  s.theta = 1.0;
-  s.affine = affine;
-  mpm::ImplicitSolver<3> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
-  mpm::VelocityBC<3> bc;
-  bc.nodes.resize(static_cast<std::size_t>(model.grid.node_count()));
-  for (std::size_t i = 0; i < bc.nodes.size(); ++i) bc.nodes[i] = static_cast<std::int64_t>(i);
-  bc.mask = 0b111;
-  bc.gradient = (dF - Mat<3>::Identity()) / dt;
-  bc.anchor = c;
-  solver.set_boundary_conditions({bc});
-  for (int k = 0; k < steps; ++k) {
-    auto stats = solver.solve_step(dt);
-    ASSERT_TRUE(stats.converged) << stats.failure;
-    solver.commit();
-  }
-}
-
 // Cauchy stress of the compressible Neo-Hookean law in 3D (method.md §3) [Pa].
 Mat<3> closed_form_sigma(const Mat<3>& F) {
   const double J = F.determinant();
@@ -85,17 +63,12 @@ void check_homogeneous(grid::ShapeKind shape, const Mat<3>& dF, int steps) {
   add_box(model, Vec<3>(0.8, 0.8, 0.8), Vec<3>(1.6, 1.6, 1.6), 2);
   const Vec<3> c(1.2, 1.2, 1.2);
   const auto X = model.points.x;
-  drive(model, shape, dF, c, steps);
+  test_support::drive_affine(model, shape, dF, c, steps);
   Mat<3> F_total = Mat<3>::Identity();
   for (int k = 0; k < steps; ++k) F_total = dF * F_total;
   const Mat<3> sigma_exact = closed_form_sigma(F_total);
-  double worst_sigma = 0, worst_x = 0, worst_F = 0;
-  for (std::size_t p = 0; p < model.points.size(); ++p) {
-    worst_F = std::max(worst_F, (model.points.F[p] - F_total).norm());
-    worst_sigma =
-        std::max(worst_sigma, (model.points.sigma[p] - sigma_exact).norm() / sigma_exact.norm());
-    worst_x = std::max(worst_x, (model.points.x[p] - (c + F_total * (X[p] - c))).norm());
-  }
+  const auto err = test_support::homogeneous_error(model, X, c, F_total, sigma_exact);
+  const double worst_F = err.F, worst_sigma = err.sigma, worst_x = err.x;
   std::printf(
       "  shape %d, %zu points: max |F - F_exact| = %.3e, max rel. stress error = %.3e, max |x - "
       "x_exact| = %.3e\n",
@@ -123,17 +96,6 @@ void surface_contact(mpm::Settings<3>& s) {
   s.contact.wall_points = true;
   s.contact.grain_faces = true;
   s.contact.active_set = true;
-}
-
-// Mean velocity of grain g [m/s].
-Vec<3> grain_velocity(const mpm::Model<3>& m, int g) {
-  Vec<3> p = Vec<3>::Zero();
-  double mass = 0;
-  for (auto i = m.grains[g].begin; i < m.grains[g].end; ++i) {
-    p += m.points.mass[i] * m.points.v[i];
-    mass += m.points.mass[i];
-  }
-  return p / mass;
 }
 
 }  // namespace
@@ -168,7 +130,7 @@ TEST(ThreeD, FullTurnAboutAnObliqueAxisLeavesNoStrain) {
     const int steps = 72;
     const Mat<3> R =
         Eigen::AngleAxisd(2 * std::numbers::pi / steps, Vec<3>(1, 2, 2) / 3.0).toRotationMatrix();
-    drive(model, shape, R, c, steps, /*affine=*/true);
+    test_support::drive_affine(model, shape, R, c, steps, 1e-3, 1.0, /*affine=*/true);
     double smax = 0, xmax = 0, jmax = 0;
     for (std::size_t p = 0; p < model.points.size(); ++p) {
       smax = std::max(smax, model.points.sigma[p].cwiseAbs().maxCoeff());
@@ -248,46 +210,14 @@ TEST(ThreeD, HeadOnImpactOfTwoSpheresConservesMomentumAndSeparates) {
     if (faces) surface_contact(s);
     mpm::ImplicitSolver<3> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
     const double dt = 0.5 * h / kCp;
-    const auto d0 = mpm::diagnostics(model);
-    const double p_one = 0.5 * d0.mass * v0;
-    double worst_p = 0, min_gap = 1e9, e_max = 0;
-    bool touched = false;
-    int k = 0;
-    for (; k < 2000; ++k) {
-      solver.set_time(k * dt);
-      auto st = solver.solve_step(dt);
-      ASSERT_TRUE(st.converged) << "step " << k << ": " << st.failure;
-      solver.commit();
-      touched = touched || st.active_contacts > 0;
-      const auto d = mpm::diagnostics(model);
-      worst_p = std::max(worst_p, (d.momentum - d0.momentum).norm() / p_one);
-      e_max = std::max(e_max, d.kinetic + d.elastic);
-      double right_a = -1e9, left_b = 1e9;
-      for (auto i = model.grains[0].begin; i < model.grains[0].end; ++i)
-        right_a = std::max(right_a, model.points.x[i][0] + model.grains[0].half_width *
-                                                               std::abs(model.points.F[i](0, 0)));
-      for (auto i = model.grains[1].begin; i < model.grains[1].end; ++i)
-        left_b = std::min(left_b, model.points.x[i][0] - model.grains[1].half_width *
-                                                             std::abs(model.points.F[i](0, 0)));
-      min_gap = std::min(min_gap, left_b - right_a);
-      if (touched && st.active_contacts == 0 && grain_velocity(model, 0)[0] < 0 &&
-          grain_velocity(model, 1)[0] > 0)
-        break;
-    }
-    const auto d1 = mpm::diagnostics(model);
-    const double va = grain_velocity(model, 0)[0], vb = grain_velocity(model, 1)[0];
+    const double p_one = 0.5 * mpm::diagnostics(model).mass * v0;
+    const auto r = test_support::head_on_impact(model, solver, dt, 2000, p_one);
     std::printf(
         "  %s: %zu points; separated after %d steps: v_A = %.4f, v_B = %.4f m/s; momentum drift "
         "%.2e of one sphere's; deepest overlap %.3f cells; energy kept %.1f %%\n",
         faces ? "face contacts + active set, CPDI" : "node contacts, linear", model.points.size(),
-        k, va, vb, worst_p, -min_gap / h,
-        100 * (d1.kinetic + d1.elastic) / (d0.kinetic + d0.elastic));
-    EXPECT_TRUE(touched);
-    EXPECT_LT(k, 2000) << "the spheres did not separate";
-    EXPECT_LT(va, 0.0);
-    EXPECT_GT(vb, 0.0);
-    EXPECT_LT(worst_p, 1e-12);
-    EXPECT_GT(min_gap, -0.5 * h) << "interpenetration beyond half a cell";
-    EXPECT_LE(d1.kinetic + d1.elastic, e_max * (1 + 1e-9));
+        r.steps, r.va, r.vb, r.worst_p, -r.min_gap / h,
+        100 * (r.d1.kinetic + r.d1.elastic) / (r.d0.kinetic + r.d0.elastic));
+    test_support::expect_clean_separation(r, h, 2000);
   }
 }
