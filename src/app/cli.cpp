@@ -10,6 +10,7 @@
 #include "mpmcd/app/model_builder.hpp"
 #include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/simulation.hpp"
+#include "mpmcd/contact/law.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/load_config.hpp"
@@ -27,6 +28,11 @@ void print_laws() {
     std::cout << law.name << ": " << law.description << "\n";
     for (const auto& p : law.params)
       std::cout << "    " << p.name << " [" << p.unit << "]: " << p.description << "\n";
+  }
+  std::cout << "\ncontact laws ([contact] law):\n";
+  for (const auto& law : contact::contact_law_registry()) {
+    std::cout << law.name << ": " << law.description << "\n";
+    for (const auto& p : law.params) std::cout << "    reads the contacts' " << p << "\n";
   }
 }
 

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "mpmcd/app/speed_check.hpp"
+#include "mpmcd/contact/law.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/packing/input.hpp"
@@ -318,13 +319,25 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
     c.friction[a * nm + b] = c.friction[b * nm + a] = p.friction;
   }
   c.walls = input_walls(cfg);
-  // The active-set solver solves the normal impulses only: refuse friction rather than drop it.
-  if (c.active_set) {
+  c.law = cfg.contact.law;
+  const contact::ContactLaw& law = contact::find_contact_law(c.law);
+  if (c.active_set && !law.active_set)
+    throw InputError(cfg.source_path, 0, "contact.solver",
+                     fmt::format("solver = \"active_set\" does not solve the contact law \"{}\": "
+                                 "use solver = \"gauss_seidel\"",
+                                 law.name));
+  // The active-set solver solves the normal impulses only, and a law may read no friction at
+  // all: refuse friction rather than drop it.
+  if (c.active_set || !law.reads("friction")) {
     const auto refuse = [&](std::int64_t line, const std::string& where) {
-      throw InputError(cfg.source_path, line, "contact.solver",
-                       fmt::format("solver = \"active_set\" solves frictionless contacts only, "
-                                   "but {} has friction: use solver = \"gauss_seidel\"",
-                                   where));
+      if (c.active_set)
+        throw InputError(cfg.source_path, line, "contact.solver",
+                         fmt::format("solver = \"active_set\" solves frictionless contacts "
+                                     "only, but {} has friction: use solver = \"gauss_seidel\"",
+                                     where));
+      throw InputError(
+          cfg.source_path, line, "contact.law",
+          fmt::format("contact law \"{}\" has no friction, but {} has friction", law.name, where));
     };
     if (cfg.contact.friction != 0.0) refuse(0, "the default grain pair (contact.friction)");
     for (const auto& p : cfg.contact.pairs)

@@ -1,5 +1,6 @@
 #include "mpmcd/contact/active_set.hpp"
 
+#include "mpmcd/contact/law.hpp"
 #include "mpmcd/core/timer.hpp"
 
 #include <Eigen/Dense>
@@ -356,7 +357,9 @@ template <int Dim>
 GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
                           ActiveSetCache* cache) {
   GsResult result;
-  const bool frictionless = std::all_of(problem.contacts.begin(), problem.contacts.end(),
+  // The pivoting solves the frictionless Signorini law: other laws and friction go to the sweeps.
+  const bool frictionless = find_contact_law(problem.law).active_set &&
+                            std::all_of(problem.contacts.begin(), problem.contacts.end(),
                                         [](const Contact<Dim>& c) { return c.friction == 0.0; });
   if (frictionless && !problem.contacts.empty()) {
     // The sweeps' answer is kept only if it meets 1e-3 of the tolerance (a warm start that was

@@ -1,15 +1,17 @@
 // The nonlinear Gauss-Seidel solver of a contact problem (method.md §4;
 // include/mpmcd/contact/problem.hpp): the slots' velocities during the sweeps (SlotVelocities,
-// respond), the sweep order and its colours (sweep_order), one sweep of local solutions with the
-// exact nodal blocks (solve_node_block, their Delassus matrices kept in a BlockCache), the sweeps
-// until the error is met (solve_gauss_seidel, serial or over a distributed problem) and the error
-// measure (error_terms, error).
+// respond), the sweep order and its colours (sweep_order), one sweep of the problem's contact
+// law's local solutions (contact/law.hpp, resolved once per solve) with the exact nodal blocks
+// (solve_node_block, their Delassus matrices kept in a BlockCache), the sweeps until the error is
+// met (solve_gauss_seidel, serial or over a distributed problem) and the error measure
+// (error_terms, error).
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
+#include "mpmcd/contact/law.hpp"
 #include "mpmcd/contact/problem.hpp"
 
 namespace mpmcd::contact {
@@ -326,9 +328,11 @@ bool solve_node_block(Problem<Dim>& p, SlotVelocities<Dim>& v, const std::int32_
   return true;
 }
 
+// local: the problem's contact law's local solver; omega and node_blocks only for a Signorini law.
 template <int Dim>
 void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const SweepOrder& runs, StageTimers* timers,
-           double omega, bool node_blocks, bool threads, BlockCache* cache) {
+           LocalSolver<Dim> local, double omega, bool node_blocks, bool threads,
+           BlockCache* cache) {
   const ThreadedRegion threaded(timers, threads);
   for (std::size_t ph = 0; ph + 1 < runs.phase.size(); ++ph)
 #pragma omp parallel for schedule(dynamic, 8) if (threads)
@@ -350,7 +354,7 @@ void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const SweepOrder& runs, Stag
         Vec<Dim> u;
         Mat<Dim> W;
         free_velocity(p, v, c, u, W);
-        Vec<Dim> P = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
+        Vec<Dim> P = local(u, W, c.normal, c.gap / p.dt, c.friction);
         if (omega != 1.0 && c.friction == 0.0)  // projected SOR on the normal cone p_n >= 0
           P = project_cone<Dim>(c.impulse + omega * (P - c.impulse), c.normal, 0.0);
         const Vec<Dim> dP = P - c.impulse;
@@ -361,12 +365,55 @@ void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const SweepOrder& runs, Stag
       }
 }
 
-// The sweeps until error() <= tolerance or max_sweeps, error() giving the (global) error.
-// error_now(threads) gives the error, its sums on the threads or not. With a tuner each sweep and
-// its error run on the threads or on one thread as the tuner chooses (the same bits either way:
-// the colours fix the order), and their time per contact is recorded.
-template <int Dim, class Error>
-GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& error_now) {
+// error_terms, its loops on the threads if `threads`, by the local solver `local`.
+template <int Dim>
+void error_sums(const Problem<Dim>& p, double& num, double& den, StageTimers* timers, bool threads,
+                LocalSolver<Dim> local) {
+  const auto v = slot_velocities(p, threads);
+  // Each contact's terms on the threads, summed in contact order (the same bits for any count).
+  const auto n = static_cast<std::int64_t>(p.contacts.size());
+  std::vector<double> tn(static_cast<std::size_t>(n)), td(static_cast<std::size_t>(n));
+  {
+    const ThreadedRegion threaded(timers, threads);
+#pragma omp parallel for schedule(static) if (threads)
+    for (std::int64_t i = 0; i < n; ++i) {
+      const Contact<Dim>& c = p.contacts[i];
+      Vec<Dim> u;
+      Mat<Dim> W;
+      free_velocity(p, v, c, u, W);
+      const Vec<Dim> loc = local(u, W, c.normal, c.gap / p.dt, c.friction);
+      tn[i] = (loc - c.impulse).squaredNorm();
+      td[i] = c.impulse.squaredNorm();
+    }
+  }
+  num = 0;
+  den = 0;
+  for (std::int64_t i = 0; i < n; ++i) {
+    num += tn[i];
+    den += td[i];
+  }
+}
+
+// sqrt(num) / sqrt(den), 0 without any change.
+double error_ratio(double num, double den) {
+  return num == 0.0 ? 0.0 : std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
+}
+
+// The sweeps until the error is <= tolerance or max_sweeps, the error summed over every part of
+// a distributed problem by `reduce` (null: a whole problem). The problem's contact law is looked up
+// once. With a tuner each sweep and its error run on the threads or on one thread as the tuner
+// chooses (the same bits either way: the colours fix the order), and their time per contact is
+// recorded.
+template <int Dim>
+GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const ErrorReduce* reduce) {
+  const ContactLaw& law = find_contact_law(p.law);
+  const LocalSolver<Dim> local = law.template local<Dim>();
+  const auto error_now = [&](bool threads) {
+    double num = 0, den = 0;
+    error_sums(p, num, den, settings.timers, threads, local);
+    if (reduce) (*reduce)(num, den);
+    return error_ratio(num, den);
+  };
   GsResult r;
   const bool can_thread = threaded_problem(p) && omp_get_max_threads() > 1;
   ThreadTuner* const tuner = can_thread ? settings.tuner : nullptr;
@@ -380,15 +427,17 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& 
   const SweepOrder& runs = settings.order ? *settings.order : own;
   const double work = static_cast<double>(p.contacts.size());
   BlockCache cache;
-  if (settings.node_blocks) {
+  const bool node_blocks = settings.node_blocks && law.signorini;
+  if (node_blocks) {
     cache.W.resize(runs.order.size());
     cache.ready.assign(runs.order.size(), 0);
   }
   while (r.sweeps < settings.max_sweeps) {
     const bool threads = tuner ? tuner->threaded() : can_thread;
     const auto t0 = std::chrono::steady_clock::now();
-    sweep(p, v, runs, settings.timers, r.sweeps >= settings.relax_after ? settings.relaxation : 1.0,
-          settings.node_blocks, threads, &cache);
+    const double omega =
+        law.signorini && r.sweeps >= settings.relax_after ? settings.relaxation : 1.0;
+    sweep(p, v, runs, settings.timers, local, omega, node_blocks, threads, &cache);
     ++r.sweeps;
     r.error = error_now(threads);
     if (tuner)
@@ -403,60 +452,18 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const Error& 
   return r;
 }
 
-// sqrt(num) / sqrt(den), 0 without any change.
-double error_ratio(double num, double den) {
-  return num == 0.0 ? 0.0 : std::sqrt(num) / std::sqrt(std::max(den, 1e-300));
-}
-
-}  // namespace
-
-namespace {
-
-// error_terms, its loops on the threads if `threads`.
-template <int Dim>
-void error_sums(const Problem<Dim>& p, double& num, double& den, StageTimers* timers,
-                bool threads) {
-  const auto v = slot_velocities(p, threads);
-  // Each contact's terms on the threads, summed in contact order (the same bits for any count).
-  const auto n = static_cast<std::int64_t>(p.contacts.size());
-  std::vector<double> tn(static_cast<std::size_t>(n)), td(static_cast<std::size_t>(n));
-  {
-    const ThreadedRegion threaded(timers, threads);
-#pragma omp parallel for schedule(static) if (threads)
-    for (std::int64_t i = 0; i < n; ++i) {
-      const Contact<Dim>& c = p.contacts[i];
-      Vec<Dim> u;
-      Mat<Dim> W;
-      free_velocity(p, v, c, u, W);
-      const Vec<Dim> loc = local_solution<Dim>(u, W, c.normal, c.gap / p.dt, c.friction);
-      tn[i] = (loc - c.impulse).squaredNorm();
-      td[i] = c.impulse.squaredNorm();
-    }
-  }
-  num = 0;
-  den = 0;
-  for (std::int64_t i = 0; i < n; ++i) {
-    num += tn[i];
-    den += td[i];
-  }
-}
-
 }  // namespace
 
 template <int Dim>
 void error_terms(const Problem<Dim>& p, double& num, double& den, StageTimers* timers) {
-  error_sums(p, num, den, timers, threaded_problem(p));
+  error_sums(p, num, den, timers, threaded_problem(p),
+             find_contact_law(p.law).template local<Dim>());
 }
 
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings,
                             const ErrorReduce& reduce) {
-  return gauss_seidel(p, settings, [&](bool threads) {
-    double num = 0, den = 0;
-    error_sums(p, num, den, settings.timers, threads);
-    reduce(num, den);
-    return error_ratio(num, den);
-  });
+  return gauss_seidel(p, settings, &reduce);
 }
 
 template <int Dim>
@@ -468,11 +475,7 @@ double error(const Problem<Dim>& p) {
 
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& p, const GsSettings& settings) {
-  return gauss_seidel(p, settings, [&](bool threads) {
-    double num = 0, den = 0;
-    error_sums(p, num, den, settings.timers, threads);
-    return error_ratio(num, den);
-  });
+  return gauss_seidel<Dim>(p, settings, nullptr);
 }
 
 #define MPMCD_INSTANTIATE(D)                                                       \

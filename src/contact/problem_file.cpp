@@ -1,12 +1,14 @@
 // A contact problem as text, to replay a step's problem outside a run (write_problem,
-// read_problem; include/mpmcd/contact/problem.hpp): one line per slot and contact, each group's
-// slots and compliance matrix, 17 significant digits.
+// read_problem; include/mpmcd/contact/problem.hpp): the contact law unless it is the default
+// ("law <name>"), one line per slot and contact, each group's slots and compliance matrix, 17
+// significant digits.
 #include <fmt/format.h>
 
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
+#include "mpmcd/contact/law.hpp"
 #include "mpmcd/contact/problem.hpp"
 #include "mpmcd/core/errors.hpp"
 
@@ -17,6 +19,7 @@ void write_problem(const Problem<Dim>& p, const std::string& path) {
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw std::runtime_error("cannot write " + path);
   out << "# mpmcd contact problem v1\n" << fmt::format("dim {}\ndt {:.17g}\n", Dim, p.dt);
+  if (p.law != Problem<Dim>{}.law) out << "law " << p.law << "\n";  // the default law: no line
   out << "slots " << p.slots.size() << "\n";
   for (const auto& s : p.slots) {
     out << fmt::format("{:.17g}", s.mass);
@@ -83,8 +86,7 @@ Problem<Dim> read_problem(const std::string& path) {
     if (!(p.dt > 0)) throw InputError(path, lineno, "dt", "expected dt > 0");
   }
   // "<key> <count>" lines; a count beyond 1e8 is a corrupt file, not a problem to allocate.
-  const auto count = [&](const char* key) {
-    auto ss = next(key);
+  const auto count_in = [&](std::istringstream& ss, const char* key) {
     expect(ss, key);
     std::size_t n = 0;
     ss >> n;
@@ -92,7 +94,30 @@ Problem<Dim> read_problem(const std::string& path) {
     if (n > 100000000) throw InputError(path, lineno, key, "count above 1e8: corrupt file");
     return n;
   };
-  p.slots.resize(count("slots"));
+  const auto count = [&](const char* key) {
+    auto ss = next(key);
+    return count_in(ss, key);
+  };
+  {
+    // An optional "law <name>" line (none: the default law), then the slots.
+    auto ss = next("slots");
+    if (ss.str().rfind("law ", 0) == 0) {
+      std::string key;
+      ss >> key >> p.law;
+      std::string known;
+      bool registered = false;
+      for (const auto& name : contact_law_names()) {
+        known += (known.empty() ? "" : ", ") + name;
+        registered = registered || name == p.law;
+      }
+      if (!registered)
+        throw InputError(
+            path, lineno, "law",
+            fmt::format("unknown contact law '{}', expected one of: {}", p.law, known));
+      ss = next("slots");
+    }
+    p.slots.resize(count_in(ss, "slots"));
+  }
   for (auto& s : p.slots) {
     auto ss = next("slot");
     ss >> s.mass;

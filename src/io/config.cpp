@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "law_keys.hpp"
+#include "mpmcd/contact/law.hpp"
 #include "mpmcd/io/config.hpp"
 #include "mpmcd/io/load_config.hpp"
 #include "mpmcd/io/schema.hpp"
@@ -306,6 +307,13 @@ Schema build_schema() {
                        "grain-grain switch-on: \"gap\" (from the points' domains: when the "
                        "materials meet) or \"overlap\" (any shared node: about a cell early)")
            .one_of({"gap", "overlap"})
+           .default_of_member(),
+       KeySpec::string("law", &ContactSection::law,
+                       "contact law of every contact, from the contact-law registry "
+                       "(contact/law.hpp): \"coulomb\" = Signorini non-penetration and Coulomb "
+                       "friction with the coefficients `friction`, `[[contact.pairs]]` and the "
+                       "walls' `friction` (docs/contact.md)")
+           .one_of(contact::contact_law_names())
            .default_of_member(),
        KeySpec::number("friction", &ContactSection::friction, "",
                        "default grain-grain Coulomb coefficient mu_f")

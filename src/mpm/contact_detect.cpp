@@ -40,6 +40,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   const ContactSettings<Dim>& cs = settings_.contact;
   const double h = grid_.cell_size();
   problem_.dt = dt;
+  problem_.law = cs.law;
   problem_.slots.clear();
   problem_.contacts.clear();
   sweep_order_ready_ = false;

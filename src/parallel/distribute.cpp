@@ -139,6 +139,7 @@ contact::Problem<Dim> gather_contacts(const Comm& comm, const contact::Problem<D
   });
   contact::Problem<Dim> p;
   p.dt = local.dt;
+  p.law = local.law;
   for (const auto& r : rows) {
     contact::Contact<Dim> c;
     if (r.body_a >= 0) {

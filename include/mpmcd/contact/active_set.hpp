@@ -62,10 +62,10 @@ struct ActiveSetCache {
 /// impulses in `problem` (enough when they are nearly right; skipped when `cache` is valid), then
 /// block principal pivoting (above) from the active set it reaches, then checks error(problem)
 /// (computed from W) and, if it is above settings.tolerance, continues with Gauss-Seidel sweeps
-/// (settings.max_sweeps). A problem with
-/// a frictional contact goes to Gauss-Seidel directly. GsResult::pivots counts the pivoting
-/// steps, GsResult::sweeps all Gauss-Seidel sweeps. With a `cache` that is valid, its W and
-/// factorisation are used instead of being made again; it is left valid with this solve's.
+/// (settings.max_sweeps). A problem with a frictional contact, or whose contact law the pivoting
+/// does not solve (ContactLaw::active_set), goes to Gauss-Seidel directly. GsResult::pivots counts
+/// the pivoting steps, GsResult::sweeps all Gauss-Seidel sweeps. With a `cache` that is valid, its
+/// W and factorisation are used instead of being made again; it is left valid with this solve's.
 template <int Dim>
 GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
                           ActiveSetCache* cache = nullptr);

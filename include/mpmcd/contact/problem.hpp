@@ -1,7 +1,8 @@
 #pragma once
-/// The contact problem of one step as plain data (method.md §4), its exact local Signorini-Coulomb
-/// solver with the lumped Delassus operator, the nonlinear Gauss-Seidel over all contacts, and the
-/// one error measure shared by the solver and the tests. It can be written to a file and replayed.
+/// The contact problem of one step as plain data (method.md §4), the default contact law's exact
+/// local Signorini-Coulomb solver (other laws: contact/law.hpp), the nonlinear Gauss-Seidel over
+/// all contacts, and the one error measure shared by the solver and the tests. It can be written
+/// to a file and replayed.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -49,7 +50,10 @@ struct Contact {
 /// The whole problem of a step.
 template <int Dim>
 struct Problem {
-  double dt = 0;                       ///< time step [s]
+  double dt = 0;  ///< time step [s]
+  /// The contact law of every contact, by its registry name (contact/law.hpp): its local solver
+  /// is looked up once per solve, not per contact.
+  std::string law = "coulomb";
   std::vector<Slot<Dim>> slots;        ///< nodes taking part
   std::vector<Contact<Dim>> contacts;  ///< contacts (their impulses are the unknowns)
   std::vector<Group> groups;           ///< compliance groups (empty: all slots lumped)
@@ -102,6 +106,7 @@ struct GsResult {
   bool converged = false;  ///< error <= tolerance
 };
 
+/// The default contact law's ("coulomb", contact/law.hpp; src/contact/coulomb.cpp) local solver.
 /// Exact solution of one contact's local problem u = u_free + W P with an SPD Delassus block W:
 /// open if u_free.n + g/dt >= 0 without impulse, else stick (u_t = 0, u_n + g/dt = 0) if its
 /// impulse lies in the Coulomb cone |p_t| <= mu p_n, else slide on the cone against the sliding
@@ -133,8 +138,8 @@ std::vector<Vec<Dim>> net_impulses(const Problem<Dim>& problem);
 
 /// Error measure shared by the solver and the tests: with the slot velocities implied by the
 /// current impulses, sqrt(sum_c |P_c - local_c(P)|^2) / sqrt(sum_c |P_c|^2), where local_c is the
-/// exact local solution of contact c with all other impulses fixed (0 when every impulse is 0 and
-/// stays 0).
+/// exact local solution of contact c by the problem's law with all other impulses fixed (0 when
+/// every impulse is 0 and stays 0).
 template <int Dim>
 double error(const Problem<Dim>& problem);
 
@@ -142,9 +147,10 @@ double error(const Problem<Dim>& problem);
 template <int Dim>
 SweepOrder sweep_order(const Problem<Dim>& problem);
 
-/// Nonlinear Gauss-Seidel: sweeps the contacts in order, each solved exactly with the others'
-/// current impulses, until error(problem) <= tolerance or max_sweeps; starts from the impulses in
-/// `problem`.
+/// Nonlinear Gauss-Seidel: sweeps the contacts in order, each solved exactly by the problem's law
+/// (its local solver) with the others' current impulses, until error(problem) <= tolerance or
+/// max_sweeps; starts from the impulses in `problem`. The exact nodal blocks and the
+/// over-relaxation apply to the frictionless contacts of a Signorini law only (ContactLaw).
 template <int Dim>
 GsResult solve_gauss_seidel(Problem<Dim>& problem, const GsSettings& settings);
 

@@ -114,6 +114,7 @@ struct ContactPairSection {
 struct ContactSection {
   bool enabled = true;            ///< solve contacts (grain-grain and grain-wall) [-]
   std::string criterion = "gap";  ///< "gap" (points' domains) or "overlap" (support overlap)
+  std::string law = "coulomb";    ///< contact law (contact/law.hpp registry name) [-]
   double friction = 0.0;          ///< default grain-grain Coulomb coefficient [-]
   double mass_fraction = 1e-4;    ///< contact node: field mass above this fraction of a cell's [-]
   double tolerance = 1e-8;        ///< Gauss-Seidel error tolerance [-]

@@ -40,7 +40,8 @@ struct ContactSettings {
   std::vector<double> friction = {
       0.0};                             ///< mu_f per material pair, row-major materials x materials
   std::vector<walls::Wall<Dim>> walls;  ///< rigid walls
-  double wall_range = 1.0;  ///< grain nodes within this many cells of a wall are candidates
+  std::string law = "coulomb";  ///< contact law of every contact (contact/law.hpp registry name)
+  double wall_range = 1.0;      ///< grain nodes within this many cells of a wall are candidates
   /// Where a wall acts (docs/accuracy.md): false = at grain nodes (the node velocity may not
   /// cross the wall), true = at the faces of the points' domains facing the wall (the velocity
   /// of the face, interpolated from the nodes, may not cross it), which holds the material edge,

@@ -59,6 +59,7 @@ TEST(Cli, ListPrintsInputReferenceAndLaws) {
   const Result b = run("list laws");
   EXPECT_EQ(b.code, 0);
   EXPECT_NE(b.output.find("neo_hookean"), std::string::npos);
+  EXPECT_NE(b.output.find("coulomb: Signorini + Coulomb"), std::string::npos);
 }
 
 // Issue 17: overlapping grains are refused at input (exit 2, both grains and the overlap named,
