@@ -33,14 +33,39 @@ Vec<Dim> local_solution(const Vec<Dim>& u_free, const Mat<Dim>& W, const Vec<Dim
     }
     return (-un0 / wnn) * n;  // degenerate W: frictionless normal impulse
   } else {
-    // 3D: isotropic approximation w = tr(W)/3 (exact for lumped W = w I).
-    const double w = W.trace() / Dim;
-    const double pn = -un0 / w;
-    const Vec<Dim> ut = u_free - u_free.dot(n) * n;
-    const Vec<Dim> pt_stick = -ut / w;
-    const double pt_norm = pt_stick.norm();
-    if (pt_norm <= mu * pn) return pn * n + pt_stick;
-    return pn * n + (mu * pn / pt_norm) * pt_stick;
+    // 3D, exact for any symmetric positive-definite W (before 2026-11-26: W approximated by
+    // tr(W)/3 I, which made Gauss-Seidel converge to wrong impulses with the grain compliance).
+    // Stick: u_free + (g/dt) n + W P = 0, kept inside the cone |P_t| <= mu p_n. Slide:
+    // P = p_n (n - mu s) with s the unit direction of the tangential velocity it leaves, found by
+    // a damped fixed point from the stick direction; p_n from the normal condition.
+    const double wnn = n.dot(W * n);
+    if (mu > 0.0) {
+      const Vec<Dim> P = -W.ldlt().solve(u_free + gap_over_dt * n);
+      const double pn = P.dot(n);
+      const Vec<Dim> pt = P - pn * n;
+      if (pn > 0.0 && pt.norm() <= mu * pn) return P;
+      const Vec<Dim> ut0 = u_free - u_free.dot(n) * n;
+      Vec<Dim> s = pt.norm() > 0.0    ? Vec<Dim>(-pt / pt.norm())
+                   : ut0.norm() > 0.0 ? Vec<Dim>(ut0 / ut0.norm())
+                                      : Vec<Dim>::Zero();
+      for (int k = 0; k < 100 && !s.isZero(); ++k) {
+        const Vec<Dim> dir = n - mu * s;
+        const double d = n.dot(W * dir);
+        if (!(d > 0.0)) break;
+        const double p = -un0 / d;
+        const Vec<Dim> u = u_free + p * (W * dir);
+        const Vec<Dim> ut = u - u.dot(n) * n;
+        if (ut.norm() == 0.0) return p * dir;
+        const Vec<Dim> s_new = ut / ut.norm();
+        if ((s_new - s).norm() < 1e-14) return p * (n - mu * s_new);
+        s = (s + s_new).normalized();
+      }
+      if (!s.isZero()) {
+        const double d = n.dot(W * (n - mu * s));
+        if (d > 0.0) return (-un0 / d) * (n - mu * s);
+      }
+    }
+    return (-un0 / wnn) * n;  // frictionless (or degenerate): the normal impulse alone
   }
 }
 
