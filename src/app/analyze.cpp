@@ -277,10 +277,10 @@ int analyze_command(const AnalyzeOptions& opt) {
                    [](const std::string& f) {
                      for (const char* own :
                           {"compaction_fit.csv", "figure4.csv", "figure5.csv", "figure4.png",
-                           "figure5.png", "figure4.pdf", "figure5.pdf", "pressure_law.csv", "phi_pressure.csv", "fabric.csv",
-                           "force_distribution.csv", "pressure_distribution.csv",
-                           "pressure_law.png", "pressure_law.pdf", "fabric.png", "fabric.pdf",
-                           "distributions.png", "distributions.pdf"})
+                           "figure5.png", "figure4.pdf", "figure5.pdf", "pressure_law.csv",
+                           "phi_pressure.csv", "fabric.csv", "force_distribution.csv",
+                           "pressure_distribution.csv", "pressure_law.png", "pressure_law.pdf",
+                           "fabric.png", "fabric.pdf", "distributions.png", "distributions.pdf"})
                        if (f == own || f == std::string(own) + ".tmp") return true;
                      return false;
                    }),
