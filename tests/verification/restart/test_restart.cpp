@@ -360,3 +360,27 @@ TEST(Restart, AFormat6CheckpointStillContinuesBitwise) {
       << mpmcd::test_support::read_file(dir / "tiny.csv") << "\nexpected\n"
       << mpmcd::test_support::read_file(src / "tiny_full.csv");
 }
+
+// Checkpoint format 8 added the servo's integral (a 13th value per wall in /loading/wall); a
+// format 7 file with [loading] (written by the mpmcd before it, format7/: a block whose top wall
+// is a servo, stopped after step 10 of 30 in the middle of its ramp) is read with the integral 0
+// and continues the run to the same CSV bytes as that mpmcd's uninterrupted run.
+TEST(Restart, AFormat7CheckpointWithLoadingStillContinuesBitwise) {
+  const fs::path src = fs::path(MPMCD_TEST_DIR) / "format7";
+  const fs::path dir = scratch("format7");
+  const fs::path ckpt = dir / "tiny_loading_checkpoint_000000010.h5";
+  fs::copy_file(src / "tiny_loading_checkpoint_000000010.h5", ckpt);
+  fs::copy_file(src / "tiny_loading_step10.csv", dir / "tiny_loading.csv");
+  ASSERT_EQ(mpmcd::test_support::read_file(ckpt).rfind("MPMCD-CHECKPOINT 7\n", 0), 0u);
+  const ck::State s = ck::read(ckpt.string());
+  EXPECT_EQ(s.step, 10);
+  ASSERT_EQ(s.loading_control.size(), 4u);
+  EXPECT_EQ(s.loading_control[1], 1) << "the top wall is not stress-controlled";
+  EXPECT_EQ(s.loading_wall.size(), 4u * 12u);
+  const int rc = run_binary({"run", "-q", "-t", "1", "--restart", ckpt.string()}, dir / "run.log");
+  ASSERT_EQ(rc, 0) << mpmcd::test_support::read_file(dir / "run.log");
+  EXPECT_TRUE(mpmcd::test_support::read_file(dir / "tiny_loading.csv") ==
+              mpmcd::test_support::read_file(src / "tiny_loading_full.csv"))
+      << mpmcd::test_support::read_file(dir / "tiny_loading.csv") << "\nexpected\n"
+      << mpmcd::test_support::read_file(src / "tiny_loading_full.csv");
+}
