@@ -263,11 +263,15 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
       if (cs.wall_points) {
         // Face contacts (ContactSettings::wall_points, docs/accuracy.md): per cell column
         // along the wall, the faces of the grain's points nearest the wall in that column (within
-        // half a point's extent of the nearest) make one contact on their mean velocity; gap = the
-        // mean distance of those faces from the wall (Signorini on the face velocity,
-        // u_n + g/dt >= 0, method.md §4). One contact per column keeps the constraints
-        // independent (one per face would give two per column of nodes when the material edge
-        // lies on a grid line, a singular Delassus operator and a stalling Gauss-Seidel).
+        // half a point's extent of the nearest) are the grain's surface there; gap = a face's
+        // distance from the wall (Signorini on the face velocity, u_n + g/dt >= 0, method.md §4).
+        // With the active-set solver each such face is one contact: as many constraints as the
+        // surface has faces, more than the node lines they move, so no combination of the
+        // surface nodes escapes them (one contact per column left an alternating mode along the
+        // wall free, which compression beyond ~20 mu released: docs/accuracy.md, "One contact
+        // per face"); the pivoting tolerates the redundancy. Gauss-Seidel stalls on redundant
+        // constraints, so with it the faces of a column make one contact on their mean velocity.
+        const bool per_face = cs.active_set;
         struct Face {
           std::int64_t column, p;
           double dist, ext;
@@ -288,27 +292,12 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         std::sort(faces.begin(), faces.end(), [](const Face& x, const Face& y) {
           return std::tie(x.column, x.dist, x.p) < std::tie(y.column, y.dist, y.p);
         });
-        for (std::size_t f0 = 0; f0 < faces.size();) {
-          std::size_t f1 = f0;
-          std::vector<std::int64_t> pts;
-          while (f1 < faces.size() && faces[f1].column == faces[f0].column) {
-            if (faces[f1].dist <= faces[f0].dist + 0.5 * faces[f0].ext) pts.push_back(faces[f1].p);
-            ++f1;
-          }
-          f0 = f1;
+        // One contact on the faces `pts`; `key` is its warm-start key (negative: not a node).
+        const auto add_contact = [&](const std::vector<std::int64_t>& pts, auto key_of) {
           Vec<Dim> x_face;
           const std::int32_t sb = face_slot(static_cast<std::int32_t>(g), pts, wall.normal, x_face);
-          if (sb < 0) continue;
-          // Warm-start key of a face contact: -1 - the grid cell of the mean face centre projected
-          // on the wall's plane through the origin (the column: stable while the faces move
-          // toward the wall and cross grid lines, when a lost warm start would hurt most).
-          const Vec<Dim> xt = x_face - x_face.dot(wall.normal) * wall.normal;
-          IVec<Dim> cell;
-          for (int d = 0; d < Dim; ++d)
-            cell[d] = std::clamp<std::int64_t>(
-                static_cast<std::int64_t>(std::floor((xt[d] - grid_.origin()[d]) / h)), 0,
-                grid_.cells()[d] - 1);
-          slot_key_[sb] = -1 - grid_.node_index(cell);
+          if (sb < 0) return;
+          slot_key_[sb] = key_of(x_face);
           contact::Contact<Dim> c;
           c.a = -1;
           c.wall = static_cast<std::int32_t>(wi);
@@ -320,6 +309,35 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
           c.impulse =
               warm(slot_key_[sb], -1 - static_cast<std::int32_t>(wi), static_cast<std::int32_t>(g));
           problem_.contacts.push_back(c);
+        };
+        // Warm-start key of a column's contact: -1 - the grid cell of the mean face centre
+        // projected on the wall's plane through the origin (the column: stable while the faces
+        // move toward the wall and cross grid lines, when a lost warm start would hurt most).
+        const auto column_key = [&](const Vec<Dim>& x_face) -> std::int64_t {
+          const Vec<Dim> xt = x_face - x_face.dot(wall.normal) * wall.normal;
+          IVec<Dim> cell;
+          for (int d = 0; d < Dim; ++d)
+            cell[d] = std::clamp<std::int64_t>(
+                static_cast<std::int64_t>(std::floor((xt[d] - grid_.origin()[d]) / h)), 0,
+                grid_.cells()[d] - 1);
+          return -1 - grid_.node_index(cell);
+        };
+        std::vector<std::int64_t> pts;
+        for (std::size_t f0 = 0; f0 < faces.size();) {
+          std::size_t f1 = f0;
+          pts.clear();
+          while (f1 < faces.size() && faces[f1].column == faces[f0].column) {
+            if (faces[f1].dist <= faces[f0].dist + 0.5 * faces[f0].ext) pts.push_back(faces[f1].p);
+            ++f1;
+          }
+          f0 = f1;
+          if (!per_face) {
+            add_contact(pts, column_key);
+            continue;
+          }
+          // A face contact's key: -1 - its point (points keep their index within a run).
+          for (const std::int64_t p : pts)
+            add_contact(std::vector<std::int64_t>{p}, [p](const Vec<Dim>&) { return -1 - p; });
         }
         continue;
       }
