@@ -95,6 +95,9 @@ struct PackingReport {
   double wall_seconds = 0.0;    ///< wall-clock time of the generation [s]
 };
 
+/// Default jam_start_phi of a 3D packing input (spheres jam near 0.64) [-].
+inline constexpr double kJamStartPhi3D = 0.55;
+
 /// Largest number of disks any reader or the generator accepts [-].
 inline constexpr std::int64_t kMaxDisks = 1'000'000;
 
