@@ -11,7 +11,7 @@
 // than at 10 cells per diameter, and smaller than the node walls' at 20. Against the formula itself
 // the face walls stay 10-14 % high at 20 cells per diameter (docs/three_d.md): issue 18's criterion
 // as written, against the half-space formula, is not met, and a correct solution would not meet it.
-// Long (about 12 minutes on a loaded 2-core machine).
+// Long (12 minutes on a loaded 2-core machine).
 #include <gtest/gtest.h>
 
 #include "../../support/sphere_squeeze.hpp"
