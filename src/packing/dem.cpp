@@ -6,15 +6,15 @@
 
 namespace mpmcd::packing::detail {
 
-Dem::Dem(std::vector<double> x, std::vector<double> y, std::vector<double> r0,
-         std::array<double, 4> box, const DemSettings& settings)
-    : s_(settings), box_(box), x_(std::move(x)), y_(std::move(y)), r0_(std::move(r0)) {
-  const std::size_t n = x_.size();
-  vx_.assign(n, 0.0);
-  vy_.assign(n, 0.0);
+template <int Dim>
+Dem<Dim>::Dem(Coords x, std::vector<double> r0, Box box, const DemSettings& settings)
+    : s_(settings), box_(box), x_(std::move(x)), r0_(std::move(r0)) {
+  const std::size_t n = r0_.size();
+  for (int a = 0; a < Dim; ++a) {
+    v_[a].assign(n, 0.0);
+    f_[a].assign(n, 0.0);
+  }
   w_.assign(n, 0.0);
-  fx_.assign(n, 0.0);
-  fy_.assign(n, 0.0);
   tq_.assign(n, 0.0);
   r_ = r0_;
   m_.resize(n);
@@ -22,11 +22,16 @@ Dem::Dem(std::vector<double> x, std::vector<double> y, std::vector<double> r0,
   ii_.resize(n);
   double m_min = 1e300;
   for (std::size_t i = 0; i < n; ++i) {
-    // Mass of a disk of reduced diameter 2 r0 with the density that gives mass 1 to diameter 1
-    // (eq. 6); moment of inertia of a uniform disk m r0^2 / 2.
-    m_[i] = 4.0 * r0_[i] * r0_[i];
+    // Mass of a grain of reduced diameter 2 r0 with the density that gives mass 1 to diameter 1
+    // (eq. 6): (2 r0)^Dim; moment of inertia of a uniform disk m r0^2 / 2, sphere 2 m r0^2 / 5.
+    if constexpr (Dim == 2) {
+      m_[i] = 4.0 * r0_[i] * r0_[i];
+      ii_[i] = 1.0 / (0.5 * m_[i] * r0_[i] * r0_[i]);
+    } else {
+      m_[i] = 8.0 * r0_[i] * r0_[i] * r0_[i];
+      ii_[i] = 1.0 / (0.4 * m_[i] * r0_[i] * r0_[i]);
+    }
     im_[i] = 1.0 / m_[i];
-    ii_[i] = 1.0 / (0.5 * m_[i] * r0_[i] * r0_[i]);
     m_min = std::min(m_min, m_[i]);
     r0_max_ = std::max(r0_max_, r0_[i]);
   }
@@ -34,50 +39,62 @@ Dem::Dem(std::vector<double> x, std::vector<double> y, std::vector<double> r0,
   dt_ = 0.1 * std::sqrt(m_min);
 }
 
-void Dem::set_scale(double scale) {
+template <int Dim>
+void Dem<Dim>::set_scale(double scale) {
   scale_ = scale;
   for (std::size_t i = 0; i < r_.size(); ++i) r_[i] = scale * r0_[i];
 }
 
-void Dem::set_positions(const std::vector<double>& x, const std::vector<double>& y) {
+template <int Dim>
+void Dem<Dim>::set_positions(const Coords& x) {
   x_ = x;
-  y_ = y;
   built_ = false;
 }
 
-void Dem::wrap() {
+template <int Dim>
+void Dem<Dim>::wrap() {
   if (!s_.periodic) return;
-  const double lx = box_[2] - box_[0], ly = box_[3] - box_[1];
-  for (std::size_t i = 0; i < x_.size(); ++i) {
-    x_[i] -= lx * std::floor((x_[i] - box_[0]) / lx);
-    y_[i] -= ly * std::floor((y_[i] - box_[1]) / ly);
-    // floor can round a value just below the upper bound up to it: keep [lo, hi).
-    if (x_[i] >= box_[2]) x_[i] = box_[0];
-    if (y_[i] >= box_[3]) y_[i] = box_[1];
+  for (int a = 0; a < Dim; ++a) {
+    const double len = length(a), lo = box_[a], hi = box_[Dim + a];
+    for (double& xi : x_[a]) {
+      xi -= len * std::floor((xi - lo) / len);
+      // floor can round a value just below the upper bound up to it: keep [lo, hi).
+      if (xi >= hi) xi = lo;
+    }
   }
 }
 
-void Dem::zero_velocities() {
-  std::fill(vx_.begin(), vx_.end(), 0.0);
-  std::fill(vy_.begin(), vy_.end(), 0.0);
+template <int Dim>
+void Dem<Dim>::zero_velocities() {
+  for (auto& v : v_) std::fill(v.begin(), v.end(), 0.0);
   std::fill(w_.begin(), w_.end(), 0.0);
 }
 
-double Dem::kinetic_energy() const {
+template <int Dim>
+double Dem<Dim>::kinetic_energy() const {
   double e = 0.0;
-  for (std::size_t i = 0; i < x_.size(); ++i)
-    e += 0.5 * m_[i] * (vx_[i] * vx_[i] + vy_[i] * vy_[i]) + 0.5 * w_[i] * w_[i] / ii_[i];
+  for (std::size_t i = 0; i < size(); ++i) {
+    double v2 = 0.0;
+    for (int a = 0; a < Dim; ++a) v2 += v_[a][i] * v_[a][i];
+    e += 0.5 * m_[i] * v2 + 0.5 * w_[i] * w_[i] / ii_[i];
+  }
   return e;
 }
 
-double Dem::max_force() const {
+template <int Dim>
+double Dem<Dim>::max_force() const {
   double f2 = 0.0;
-  for (std::size_t i = 0; i < x_.size(); ++i) f2 = std::max(f2, fx_[i] * fx_[i] + fy_[i] * fy_[i]);
+  for (std::size_t i = 0; i < size(); ++i) {
+    double fi = 0.0;
+    for (int a = 0; a < Dim; ++a) fi += f_[a][i] * f_[a][i];
+    f2 = std::max(f2, fi);
+  }
   return std::sqrt(f2);
 }
 
-void Dem::build_neighbours() {
-  const std::size_t n = x_.size();
+template <int Dim>
+void Dem<Dim>::build_neighbours() {
+  const std::size_t n = size();
   // Old list kept to carry the tangential springs over (eq. 4).
   std::vector<std::int64_t> old_start;
   std::vector<std::int32_t> old_j;
@@ -92,7 +109,6 @@ void Dem::build_neighbours() {
   nb_j_.clear();
   nb_xi_.clear();
   ref_x_ = x_;
-  ref_y_ = y_;
   ref_scale_ = scale_;
   built_ = true;
   if (n == 0) return;
@@ -101,41 +117,45 @@ void Dem::build_neighbours() {
   // pair within reach lies in the same or an adjacent cell. Periodic cells span the box and wrap
   // around (at least 3 cells per axis, else all pairs are tested).
   const bool per = s_.periodic;
-  const double lx = box_[2] - box_[0], ly = box_[3] - box_[1];
   if (per) wrap();
-  double lox = x_[0], hix = x_[0], loy = y_[0], hiy = y_[0];
-  for (std::size_t i = 1; i < n; ++i) {
-    lox = std::min(lox, x_[i]);
-    hix = std::max(hix, x_[i]);
-    loy = std::min(loy, y_[i]);
-    hiy = std::max(hiy, y_[i]);
-  }
-  if (per) {
-    lox = box_[0];
-    hix = box_[2];
-    loy = box_[1];
-    hiy = box_[3];
+  std::array<double, Dim> lo, hi;
+  for (int a = 0; a < Dim; ++a) {
+    if (per) {
+      lo[a] = box_[a];
+      hi[a] = box_[Dim + a];
+    } else {
+      const auto [mn, mx] = std::minmax_element(x_[a].begin(), x_[a].end());
+      lo[a] = *mn;
+      hi[a] = *mx;
+    }
   }
   const double reach = 2.0 * scale_ * r0_max_ + s_.skin;
-  const auto cells_along = [&](double extent) {
-    const double c = std::floor(extent / reach);
-    return static_cast<std::int64_t>(std::clamp(c, 1.0, 4096.0));
-  };
-  std::int64_t ncx = cells_along(hix - lox), ncy = cells_along(hiy - loy);
-  const bool all_pairs = per && (ncx < 3 || ncy < 3);
-  if (all_pairs) ncx = ncy = 1;
-  const double wx = per ? (hix - lox) / static_cast<double>(ncx)
-                        : std::max((hix - lox) / static_cast<double>(ncx), reach);
-  const double wy = per ? (hiy - loy) / static_cast<double>(ncy)
-                        : std::max((hiy - loy) / static_cast<double>(ncy), reach);
-  const auto cell_of = [&](double v, double lo, double w, std::int64_t nc) {
-    return std::clamp(static_cast<std::int64_t>((v - lo) / w), std::int64_t{0}, nc - 1);
-  };
+  // At most 4096 cells per axis in 2D, 256 in 3D (16.8 M cells either way).
+  const double max_cells = Dim == 2 ? 4096.0 : 256.0;
+  std::array<std::int64_t, Dim> nc;
+  bool all_pairs = false;
+  for (int a = 0; a < Dim; ++a) {
+    nc[a] =
+        static_cast<std::int64_t>(std::clamp(std::floor((hi[a] - lo[a]) / reach), 1.0, max_cells));
+    all_pairs = all_pairs || (per && nc[a] < 3);
+  }
+  if (all_pairs) nc.fill(1);
+  std::array<double, Dim> width;
+  std::int64_t cells = 1;
+  for (int a = 0; a < Dim; ++a) {
+    const double w = (hi[a] - lo[a]) / static_cast<double>(nc[a]);
+    width[a] = per ? w : std::max(w, reach);
+    cells *= nc[a];
+  }
+  // Cell of grain i: index sum_a c_a prod_{b < a} nc_b (2D: c_y nc_x + c_x).
   std::vector<std::int32_t> cell(n);
-  cell_start_.assign(static_cast<std::size_t>(ncx * ncy + 1), 0);
+  cell_start_.assign(static_cast<std::size_t>(cells + 1), 0);
   for (std::size_t i = 0; i < n; ++i) {
-    cell[i] = static_cast<std::int32_t>(cell_of(y_[i], loy, wy, ncy) * ncx +
-                                        cell_of(x_[i], lox, wx, ncx));
+    std::int64_t idx = 0;
+    for (int a = Dim - 1; a >= 0; --a)
+      idx = idx * nc[a] + std::clamp(static_cast<std::int64_t>((x_[a][i] - lo[a]) / width[a]),
+                                     std::int64_t{0}, nc[a] - 1);
+    cell[i] = static_cast<std::int32_t>(idx);
     ++cell_start_[cell[i] + 1];
   }
   std::partial_sum(cell_start_.begin(), cell_start_.end(), cell_start_.begin());
@@ -144,26 +164,38 @@ void Dem::build_neighbours() {
     std::vector<std::int32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) cell_items_[fill[cell[i]]++] = static_cast<std::int32_t>(i);
   }
-  const std::int64_t span = all_pairs ? 0 : 1;
+  const int offsets = all_pairs ? 1 : (Dim == 2 ? 9 : 27);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::int64_t cx = cell[i] % ncx, cy = cell[i] / ncx;
+    std::array<std::int64_t, Dim> ci;
+    std::int64_t rest = cell[i];
+    for (int a = 0; a < Dim; ++a) {
+      ci[a] = rest % nc[a];
+      rest /= nc[a];
+    }
     const std::size_t row = nb_j_.size();
-    for (std::int64_t oy = -span; oy <= span; ++oy) {
-      std::int64_t ey = cy + oy;
-      if (per) ey = (ey + ncy) % ncy;
-      if (ey < 0 || ey >= ncy) continue;
-      for (std::int64_t ox = -span; ox <= span; ++ox) {
-        std::int64_t ex = cx + ox;
-        if (per) ex = (ex + ncx) % ncx;
-        if (ex < 0 || ex >= ncx) continue;
-        const std::int64_t c = ey * ncx + ex;
-        for (std::int32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
-          const std::int32_t j = cell_items_[k];
-          if (static_cast<std::size_t>(j) <= i) continue;
-          const double dx = image(x_[j] - x_[i], lx), dy = image(y_[j] - y_[i], ly);
-          const double cut = r_[i] + r_[j] + s_.skin;
-          if (dx * dx + dy * dy < cut * cut) nb_j_.push_back(j);
+    for (int k = 0; k < offsets; ++k) {
+      // Neighbour cell: offset (k / 3^a) % 3 - 1 along axis a (0 when all pairs are tested).
+      std::int64_t c = 0;
+      bool inside = true;
+      for (int a = Dim - 1; a >= 0; --a) {
+        int div = 1;
+        for (int b = 0; b < a; ++b) div *= 3;
+        std::int64_t e = ci[a] + (all_pairs ? 0 : (k / div) % 3 - 1);
+        if (per) e = (e + nc[a]) % nc[a];
+        inside = inside && e >= 0 && e < nc[a];
+        c = c * nc[a] + e;
+      }
+      if (!inside) continue;
+      for (std::int32_t k2 = cell_start_[c]; k2 < cell_start_[c + 1]; ++k2) {
+        const std::int32_t j = cell_items_[k2];
+        if (static_cast<std::size_t>(j) <= i) continue;
+        double d2 = 0.0;
+        for (int a = 0; a < Dim; ++a) {
+          const double d = image(x_[a][j] - x_[a][i], length(a));
+          d2 += d * d;
         }
+        const double cut = r_[i] + r_[j] + s_.skin;
+        if (d2 < cut * cut) nb_j_.push_back(j);
       }
     }
     std::sort(nb_j_.begin() + static_cast<std::ptrdiff_t>(row), nb_j_.end());
@@ -181,7 +213,8 @@ void Dem::build_neighbours() {
   }
 }
 
-void Dem::maybe_rebuild() {
+template <int Dim>
+void Dem<Dim>::maybe_rebuild() {
   if (!built_) {
     build_neighbours();
     return;
@@ -189,19 +222,22 @@ void Dem::maybe_rebuild() {
   // A pair absent from the list had a gap > skin at build time; the gap shrinks by at most the
   // two displacements plus the two radius increases, so rebuild before 2 (d_max + dr_max) > skin.
   double d2 = 0.0;
-  const double lx = box_[2] - box_[0], ly = box_[3] - box_[1];
-  for (std::size_t i = 0; i < x_.size(); ++i) {
-    const double dx = image(x_[i] - ref_x_[i], lx), dy = image(y_[i] - ref_y_[i], ly);
-    d2 = std::max(d2, dx * dx + dy * dy);
+  for (std::size_t i = 0; i < size(); ++i) {
+    double di = 0.0;
+    for (int a = 0; a < Dim; ++a) {
+      const double d = image(x_[a][i] - ref_x_[a][i], length(a));
+      di += d * d;
+    }
+    d2 = std::max(d2, di);
   }
   const double dr = std::max(0.0, (scale_ - ref_scale_) * r0_max_);
   if (2.0 * (std::sqrt(d2) + dr) > s_.skin) build_neighbours();
 }
 
-void Dem::compute_forces(bool viscous, double dt) {
-  const std::size_t n = x_.size();
-  std::fill(fx_.begin(), fx_.end(), 0.0);
-  std::fill(fy_.begin(), fy_.end(), 0.0);
+template <int Dim>
+void Dem<Dim>::compute_forces(bool viscous, double dt) {
+  const std::size_t n = size();
+  for (auto& f : f_) std::fill(f.begin(), f.end(), 0.0);
   std::fill(tq_.begin(), tq_.end(), 0.0);
   double max_ov = 0.0, energy = 0.0;
   const bool hertz = s_.law == ContactLaw::kHertz;
@@ -217,115 +253,132 @@ void Dem::compute_forces(bool viscous, double dt) {
     e += 0.5 * delta * delta;
     return delta;
   };
-  const double lx = box_[2] - box_[0], ly = box_[3] - box_[1];
+  std::array<double, Dim> len;
+  for (int a = 0; a < Dim; ++a) len[a] = length(a);
   for (std::size_t i = 0; i < n; ++i) {
-    const double xi = x_[i], yi = y_[i], ri = r_[i];
-    double fxi = 0.0, fyi = 0.0, tqi = 0.0;
+    const double ri = r_[i];
+    std::array<double, Dim> fi{};
+    double tqi = 0.0;
     for (std::int64_t k = nb_start_[i]; k < nb_start_[i + 1]; ++k) {
       const std::int32_t j = nb_j_[k];
-      const double dx = image(x_[j] - xi, lx), dy = image(y_[j] - yi, ly), rs = ri + r_[j];
-      const double d2 = dx * dx + dy * dy;
+      std::array<double, Dim> dx;
+      double d2 = 0.0;
+      for (int a = 0; a < Dim; ++a) {
+        dx[a] = image(x_[a][j] - x_[a][i], len[a]);
+        d2 += dx[a] * dx[a];
+      }
+      const double rs = ri + r_[j];
       if (d2 >= rs * rs) {
         nb_xi_[k] = 0.0;
         continue;
       }
       const double d = std::sqrt(d2);
-      const double nx = d > 0.0 ? dx / d : 1.0, ny = d > 0.0 ? dy / d : 0.0;
+      std::array<double, Dim> nv;
+      for (int a = 0; a < Dim; ++a) nv[a] = d > 0.0 ? dx[a] / d : (a == 0 ? 1.0 : 0.0);
       const double delta = rs - d;
       max_ov = std::max(max_ov, delta);
       double fn = elastic(delta, ri * r_[j] / rs, energy);
-      const double dvx = vx_[i] - vx_[j], dvy = vy_[i] - vy_[j];
+      std::array<double, Dim> dv;
+      double dvn = 0.0;
+      for (int a = 0; a < Dim; ++a) {
+        dv[a] = v_[a][i] - v_[a][j];
+        dvn += dv[a] * nv[a];
+      }
       if (viscous) {
         // Normal viscous damping (eq. 3): gamma_n = 2 zeta sqrt(m* k_n), m* reduced mass.
         const double mstar = m_[i] * m_[j] / (m_[i] + m_[j]);
-        fn = std::max(0.0, fn + 2.0 * s_.damping_ratio * std::sqrt(mstar) * (dvx * nx + dvy * ny));
+        fn = std::max(0.0, fn + 2.0 * s_.damping_ratio * std::sqrt(mstar) * dvn);
       }
-      fxi -= fn * nx;
-      fyi -= fn * ny;
-      fx_[j] += fn * nx;
-      fy_[j] += fn * ny;
-      if (friction) {
-        // Tangential spring with Coulomb cap (eq. 4), t = n rotated by +90 degrees.
-        const double tx = -ny, ty = nx;
-        const double vt = dvx * tx + dvy * ty + w_[i] * ri + w_[j] * r_[j];
-        double& xit = nb_xi_[k];
-        xit += vt * dt;
-        double ft = -kt * xit;
-        const double cap = s_.friction * fn;
-        if (std::abs(ft) > cap) {
-          ft = std::copysign(cap, ft);
-          xit = -ft / kt;
+      for (int a = 0; a < Dim; ++a) {
+        fi[a] -= fn * nv[a];
+        f_[a][j] += fn * nv[a];
+      }
+      if constexpr (Dim == 2) {
+        if (friction) {
+          // Tangential spring with Coulomb cap (eq. 4), t = n rotated by +90 degrees.
+          const double tx = -nv[1], ty = nv[0];
+          const double vt = dv[0] * tx + dv[1] * ty + w_[i] * ri + w_[j] * r_[j];
+          double& xit = nb_xi_[k];
+          xit += vt * dt;
+          double ft = -kt * xit;
+          const double cap = s_.friction * fn;
+          if (std::abs(ft) > cap) {
+            ft = std::copysign(cap, ft);
+            xit = -ft / kt;
+          }
+          fi[0] += ft * tx;
+          fi[1] += ft * ty;
+          f_[0][j] -= ft * tx;
+          f_[1][j] -= ft * ty;
+          tqi += ri * ft;
+          tq_[j] += r_[j] * ft;
         }
-        fxi += ft * tx;
-        fyi += ft * ty;
-        fx_[j] -= ft * tx;
-        fy_[j] -= ft * ty;
-        tqi += ri * ft;
-        tq_[j] += r_[j] * ft;
+      } else {
+        (void)friction;
+        (void)kt;
+        (void)dt;
       }
     }
-    // Frictionless rigid walls, same normal law with R* = r_i and m* = m_i (§2).
-    const double gap[4] = {xi - box_[0], yi - box_[1], box_[2] - xi, box_[3] - yi};
-    const double vn[4] = {wall_v_[0] - vx_[i], wall_v_[1] - vy_[i], vx_[i] - wall_v_[2],
-                          vy_[i] - wall_v_[3]};
-    const double sign[4] = {1.0, 1.0, -1.0, -1.0};
-    for (int wdx = 0; wdx < (s_.periodic ? 0 : 4); ++wdx) {
-      const double delta = ri - gap[wdx];
+    // Frictionless rigid walls, same normal law with R* = r_i and m* = m_i (§2): wall w is the
+    // lower (w < Dim) or upper side of axis w % Dim.
+    for (int wdx = 0; wdx < (s_.periodic ? 0 : 2 * Dim); ++wdx) {
+      const int a = wdx % Dim;
+      const bool lower = wdx < Dim;
+      const double gap = lower ? x_[a][i] - box_[wdx] : box_[wdx] - x_[a][i];
+      const double delta = ri - gap;
       if (delta <= 0.0) continue;
       max_ov = std::max(max_ov, delta);
       double fn = elastic(delta, ri, energy);
-      if (viscous) fn = std::max(0.0, fn + 2.0 * s_.damping_ratio * std::sqrt(m_[i]) * vn[wdx]);
-      if (wdx % 2 == 0)
-        fxi += sign[wdx] * fn;
-      else
-        fyi += sign[wdx] * fn;
+      const double vn = lower ? wall_v_[wdx] - v_[a][i] : v_[a][i] - wall_v_[wdx];
+      if (viscous) fn = std::max(0.0, fn + 2.0 * s_.damping_ratio * std::sqrt(m_[i]) * vn);
+      fi[a] += lower ? fn : -fn;
     }
     if (viscous) {
       // Background drag (eq. 5).
-      fxi -= s_.global_damping * m_[i] * vx_[i];
-      fyi -= s_.global_damping * m_[i] * vy_[i];
+      for (int a = 0; a < Dim; ++a) fi[a] -= s_.global_damping * m_[i] * v_[a][i];
       tqi -= s_.global_damping * w_[i] / ii_[i];
     }
-    fx_[i] += fxi;
-    fy_[i] += fyi;
+    for (int a = 0; a < Dim; ++a) f_[a][i] += fi[a];
     tq_[i] += tqi;
   }
   max_overlap_ = max_ov;
   energy_ = energy;
 }
 
-void Dem::update_forces(bool viscous) {
+template <int Dim>
+void Dem<Dim>::update_forces(bool viscous) {
   maybe_rebuild();
   compute_forces(viscous, 0.0);
 }
 
-void Dem::md_step(double dt) {
+template <int Dim>
+void Dem<Dim>::md_step(double dt) {
   // Velocity Verlet (eq. 7); the viscous forces use the half-step velocities.
-  const std::size_t n = x_.size();
+  const std::size_t n = size();
   if (!built_) update_forces(true);
-  const bool spin = s_.friction > 0.0;
+  const bool spin = Dim == 2 && s_.friction > 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    vx_[i] += 0.5 * dt * fx_[i] * im_[i];
-    vy_[i] += 0.5 * dt * fy_[i] * im_[i];
-    x_[i] += dt * vx_[i];
-    y_[i] += dt * vy_[i];
+    for (int a = 0; a < Dim; ++a) {
+      v_[a][i] += 0.5 * dt * f_[a][i] * im_[i];
+      x_[a][i] += dt * v_[a][i];
+    }
     if (spin) w_[i] += 0.5 * dt * tq_[i] * ii_[i];
   }
   maybe_rebuild();
   compute_forces(true, dt);
   for (std::size_t i = 0; i < n; ++i) {
-    vx_[i] += 0.5 * dt * fx_[i] * im_[i];
-    vy_[i] += 0.5 * dt * fy_[i] * im_[i];
+    for (int a = 0; a < Dim; ++a) v_[a][i] += 0.5 * dt * f_[a][i] * im_[i];
     if (spin) w_[i] += 0.5 * dt * tq_[i] * ii_[i];
   }
   ++steps_;
 }
 
-MinimizeResult Dem::minimize(std::int64_t max_steps, double overlap_stop, double energy_stop,
-                             double force_stop) {
+template <int Dim>
+MinimizeResult Dem<Dim>::minimize(std::int64_t max_steps, double overlap_stop, double energy_stop,
+                                  double force_stop) {
   // FIRE 2.0 (Guenole et al., Comput. Mater. Sci. 175 (2020) 109584, Algorithm 2) with
   // semi-implicit Euler steps; parameters of their Table 1.
-  const std::size_t n = x_.size();
+  const std::size_t n = size();
   // dt_max = 5 dt (not their 10 dt): measured 10-20 times faster near jamming (§7).
   const double dt_max = 5.0 * dt_, dt_min = 0.02 * dt_;
   const double alpha0 = 0.1, f_inc = 1.1, f_dec = 0.5, f_alpha = 0.99;
@@ -344,7 +397,11 @@ MinimizeResult Dem::minimize(std::int64_t max_steps, double overlap_stop, double
       break;
     }
     double p = 0.0;
-    for (std::size_t i = 0; i < n; ++i) p += fx_[i] * vx_[i] + fy_[i] * vy_[i];
+    for (std::size_t i = 0; i < n; ++i) {
+      double pi = 0.0;
+      for (int a = 0; a < Dim; ++a) pi += f_[a][i] * v_[a][i];
+      p += pi;
+    }
     if (p > 0.0) {
       if (++n_pos > n_delay) {
         dt = std::min(dt * f_inc, dt_max);
@@ -354,27 +411,28 @@ MinimizeResult Dem::minimize(std::int64_t max_steps, double overlap_stop, double
       n_pos = 0;
       if (it >= n_delay) dt = std::max(dt * f_dec, dt_min);
       alpha = alpha0;
-      for (std::size_t i = 0; i < n; ++i) {
-        x_[i] -= 0.5 * dt * vx_[i];
-        y_[i] -= 0.5 * dt * vy_[i];
-      }
+      for (int a = 0; a < Dim; ++a)
+        for (std::size_t i = 0; i < n; ++i) x_[a][i] -= 0.5 * dt * v_[a][i];
       zero_velocities();
     }
     // Semi-implicit Euler with the FIRE velocity mixing v <- (1 - a) v + a |v| F / |F|.
     double v2 = 0.0, f2 = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      vx_[i] += dt * fx_[i] * im_[i];
-      vy_[i] += dt * fy_[i] * im_[i];
-      v2 += vx_[i] * vx_[i] + vy_[i] * vy_[i];
-      f2 += fx_[i] * fx_[i] + fy_[i] * fy_[i];
+      double vi = 0.0, fi = 0.0;
+      for (int a = 0; a < Dim; ++a) {
+        v_[a][i] += dt * f_[a][i] * im_[i];
+        vi += v_[a][i] * v_[a][i];
+        fi += f_[a][i] * f_[a][i];
+      }
+      v2 += vi;
+      f2 += fi;
     }
     const double mix = f2 > 0.0 ? alpha * std::sqrt(v2 / f2) : 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      vx_[i] = (1.0 - alpha) * vx_[i] + mix * fx_[i];
-      vy_[i] = (1.0 - alpha) * vy_[i] + mix * fy_[i];
-      x_[i] += dt * vx_[i];
-      y_[i] += dt * vy_[i];
-    }
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < Dim; ++a) {
+        v_[a][i] = (1.0 - alpha) * v_[a][i] + mix * f_[a][i];
+        x_[a][i] += dt * v_[a][i];
+      }
     maybe_rebuild();
     compute_forces(false, 0.0);
     ++res.steps;
@@ -388,5 +446,8 @@ MinimizeResult Dem::minimize(std::int64_t max_steps, double overlap_stop, double
   zero_velocities();
   return res;
 }
+
+template class Dem<2>;
+template class Dem<3>;
 
 }  // namespace mpmcd::packing::detail

@@ -1,6 +1,7 @@
 #pragma once
-// Private to the packing module: the 2D disk DEM in reduced units (docs/packing.md §2):
-// length = mean diameter, stiffness = k_n = 1, mass of a disk of diameter 1 = 1.
+// Private to the packing module: the disk (2D) and sphere (3D) DEM in reduced units
+// (docs/packing.md §2): length = mean diameter, stiffness = k_n = 1, mass of a grain of diameter
+// 1 = 1.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -13,7 +14,7 @@ namespace mpmcd::packing::detail {
 /// Contact and damping settings of the DEM (reduced units).
 struct DemSettings {
   ContactLaw law = ContactLaw::kLinear;  ///< normal force law (eq. 1, 2)
-  double friction = 0.0;                 ///< Coulomb coefficient mu (eq. 4) [-]
+  double friction = 0.0;                 ///< Coulomb coefficient mu (eq. 4), 2D only [-]
   double tangential_ratio = 0.5;         ///< k_t / k_n (eq. 4) [-]
   double damping_ratio = 0.7;            ///< zeta of eq. 3 [-]
   double global_damping = 0.1;           ///< gamma_g of eq. 5 [1/time]
@@ -25,27 +26,43 @@ struct DemSettings {
 struct MinimizeResult {
   std::int64_t steps = 0;        ///< FIRE steps taken
   double energy_per_disk = 0.0;  ///< elastic energy / N at the end [k_n d^2]
-  double max_force = 0.0;        ///< largest net force on a disk at the end [k_n d]
+  double max_force = 0.0;        ///< largest net force on a grain at the end [k_n d]
   bool converged = false;        ///< a stopping criterion was met before the step limit
 };
 
-/// The disk system: structure of arrays, Verlet neighbour list built from cell lists.
+/// Dim-th root: sqrt in 2D, cbrt in 3D (radius scale for a packing fraction ratio, eq. 9) [-].
+template <int Dim>
+double dim_root(double v) {
+  if constexpr (Dim == 2)
+    return std::sqrt(v);
+  else
+    return std::cbrt(v);
+}
+
+/// The grain system in Dim = 2 (disks) or 3 (spheres): structure of arrays (one vector per axis),
+/// Verlet neighbour list built from cell lists. Friction (tangential springs, spins) is 2D only.
+template <int Dim>
 class Dem {
  public:
-  /// Disks with centers (x, y) and reference radii r0 (radius = scale * r0) in the box
-  /// [xlo, xhi] x [ylo, yhi]; masses m = (2 r0)^2 (eq. 6).
-  Dem(std::vector<double> x, std::vector<double> y, std::vector<double> r0,
-      std::array<double, 4> box, const DemSettings& settings);
+  static_assert(Dim == 2 || Dim == 3);
+  /// Coordinates, one vector per axis [d_mean].
+  using Coords = std::array<std::vector<double>, Dim>;
+  /// Walls {lo_0, .., lo_{Dim-1}, hi_0, .., hi_{Dim-1}} [d_mean] (2D: {xlo, ylo, xhi, yhi}).
+  using Box = std::array<double, 2 * Dim>;
 
-  std::size_t size() const { return x_.size(); }
-  /// Sets radius = scale * r0 for every disk.
+  /// Grains with centers x and reference radii r0 (radius = scale * r0) in the box; masses
+  /// m = (2 r0)^Dim (eq. 6).
+  Dem(Coords x, std::vector<double> r0, Box box, const DemSettings& settings);
+
+  std::size_t size() const { return r_.size(); }
+  /// Sets radius = scale * r0 for every grain.
   void set_scale(double scale);
   double scale() const { return scale_; }
-  /// Sets the walls {xlo, ylo, xhi, yhi}.
-  void set_box(const std::array<double, 4>& box) { box_ = box; }
-  const std::array<double, 4>& box() const { return box_; }
-  /// Sets the wall velocities {left.x, bottom.y, right.x, top.y} used by the contact damping.
-  void set_wall_velocity(const std::array<double, 4>& v) { wall_v_ = v; }
+  /// Sets the walls.
+  void set_box(const Box& box) { box_ = box; }
+  const Box& box() const { return box_; }
+  /// Sets the wall velocities (normal component of each wall, order of Box) for the damping.
+  void set_wall_velocity(const Box& v) { wall_v_ = v; }
 
   /// Time step of the damped dynamics: 0.1 sqrt(m_min / k_n) (§2).
   double time_step() const { return dt_; }
@@ -67,18 +84,15 @@ class Dem {
   double energy() const { return energy_; }
   /// Kinetic energy (translation + rotation) [k_n d^2].
   double kinetic_energy() const;
-  /// Largest |F| on a disk in the last force evaluation [k_n d].
+  /// Largest |F| on a grain in the last force evaluation [k_n d].
   double max_force() const;
 
-  const std::vector<double>& x() const { return x_; }
-  const std::vector<double>& y() const { return y_; }
+  /// Centers along axis a [d_mean].
+  const std::vector<double>& x(int a) const { return x_[a]; }
   const std::vector<double>& r() const { return r_; }
   /// Positions, for saving/restoring states.
-  void get_positions(std::vector<double>& x, std::vector<double>& y) const {
-    x = x_;
-    y = y_;
-  }
-  void set_positions(const std::vector<double>& x, const std::vector<double>& y);
+  void get_positions(Coords& x) const { x = x_; }
+  void set_positions(const Coords& x);
   /// Wraps the centers into the periodic cell (no-op with walls).
   void wrap();
   /// Total DEM steps (dynamics + FIRE) done so far.
@@ -96,19 +110,21 @@ class Dem {
     if (d < -0.5 * len) return d + len;
     return d;
   }
+  double length(int a) const { return box_[Dim + a] - box_[a]; }
 
   DemSettings s_;
-  std::array<double, 4> box_;
-  std::array<double, 4> wall_v_{0.0, 0.0, 0.0, 0.0};
-  std::vector<double> x_, y_, vx_, vy_, w_, fx_, fy_, tq_, r0_, r_, m_, im_, ii_;
+  Box box_;
+  Box wall_v_{};
+  Coords x_, v_, f_;
+  std::vector<double> w_, tq_, r0_, r_, m_, im_, ii_;  // spin and torque: 2D friction only
   double scale_ = 1.0;
   double r0_max_ = 0.0;
   double dt_ = 0.0;
-  // Verlet list in CSR form: neighbours j > i of disk i are nb_j_[nb_start_[i] .. [i+1]).
+  // Verlet list in CSR form: neighbours j > i of grain i are nb_j_[nb_start_[i] .. [i+1]).
   std::vector<std::int64_t> nb_start_;
   std::vector<std::int32_t> nb_j_;
   std::vector<double> nb_xi_;  // tangential spring elongation per pair (eq. 4)
-  std::vector<double> ref_x_, ref_y_;
+  Coords ref_x_;
   double ref_scale_ = 0.0;
   std::vector<std::int32_t> cell_start_, cell_items_;
   double max_overlap_ = 0.0;
@@ -116,5 +132,8 @@ class Dem {
   std::int64_t steps_ = 0;
   bool built_ = false;
 };
+
+extern template class Dem<2>;
+extern template class Dem<3>;
 
 }  // namespace mpmcd::packing::detail

@@ -23,6 +23,9 @@ std::optional<ParamProblem> check_params(const PackingParams& p) {
     return std::optional<ParamProblem>(ParamProblem{std::move(key), std::move(what)});
   };
   const auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (p.dimension != 2 && p.dimension != 3)
+    return bad("dimension", fmt::format("2 (disks) or 3 (spheres), got {}", p.dimension));
+  const bool three = p.dimension == 3;
   if (!p.diameters.empty()) {
     if (static_cast<std::int64_t>(p.diameters.size()) > kMaxDisks)
       return bad("diameters",
@@ -49,23 +52,35 @@ std::optional<ParamProblem> check_params(const PackingParams& p) {
   }
   if (p.box) {
     const auto& b = *p.box;
+    const auto& z = p.box_z;
     for (double v : b)
-      if (!std::isfinite(v)) return bad("box", "four finite numbers [m]");
-    if (!(b[2] > b[0]) || !(b[3] > b[1]))
+      if (!std::isfinite(v))
+        return bad("box", three ? "six finite numbers [m]" : "four finite numbers [m]");
+    if (three && !(std::isfinite(z[0]) && std::isfinite(z[1])))
+      return bad("box", "six finite numbers [m]");
+    if (!three && (!(b[2] > b[0]) || !(b[3] > b[1])))
       return bad("box", fmt::format("[xmin, ymin, xmax, ymax] with xmax > xmin and ymax > ymin, "
                                     "got [{}, {}, {}, {}]",
                                     b[0], b[1], b[2], b[3]));
+    if (three && (!(b[2] > b[0]) || !(b[3] > b[1]) || !(z[1] > z[0])))
+      return bad("box", fmt::format("[xmin, ymin, zmin, xmax, ymax, zmax] with each max > min, "
+                                    "got [{}, {}, {}, {}, {}, {}]",
+                                    b[0], b[1], z[0], b[2], b[3], z[1]));
   } else {
     if (!std::isfinite(p.aspect_ratio) || p.aspect_ratio < 1e-3 || p.aspect_ratio > 1e3)
       return bad("aspect_ratio", fmt::format("a number in [0.001, 1000], got {}", p.aspect_ratio));
-    if (!std::isfinite(p.origin[0]) || !std::isfinite(p.origin[1]))
-      return bad("origin", "two finite numbers [m]");
+    if (!std::isfinite(p.origin[0]) || !std::isfinite(p.origin[1]) ||
+        (three && !std::isfinite(p.origin_z)))
+      return bad("origin", three ? "three finite numbers [m]" : "two finite numbers [m]");
   }
   if (p.method != PackingMethod::kJam &&
       (!std::isfinite(p.target_phi) || p.target_phi <= 0.0 || p.target_phi > 0.9))
     return bad("target_phi", fmt::format("a number in (0, 0.9], got {}", p.target_phi));
   if (!std::isfinite(p.friction) || p.friction < 0.0 || p.friction > 10.0)
     return bad("friction", fmt::format("a number in [0, 10], got {}", p.friction));
+  if (three && p.friction != 0.0)
+    return bad("friction",
+               fmt::format("0 in 3D (the sphere DEM is frictionless), got {}", p.friction));
   if (p.periodic && p.method == PackingMethod::kWalls)
     return bad("boundary", "\"walls\" for method \"walls\" (a periodic cell has no walls)");
   if (p.method == PackingMethod::kJam && p.friction != 0.0)
@@ -103,8 +118,6 @@ std::optional<ParamProblem> check_params(const PackingParams& p) {
 
 namespace {
 
-using detail::Dem;
-
 // Uniform double in [0, 1) (docs/packing.md eq. 0) from the 53 high bits of one mt19937_64 draw
 // (portable, unlike std::uniform_real_distribution).
 double uniform01(std::mt19937_64& rng) {
@@ -121,7 +134,8 @@ constexpr double kForceStop = 1e-6;
 
 // Frictional relaxation with damped dynamics: until overlaps < tol and kinetic energy per disk
 // < 1e-14 (§4). Returns true when both held.
-bool relax_damped(Dem& dem, std::int64_t max_steps, double tol) {
+template <int Dim>
+bool relax_damped(detail::Dem<Dim>& dem, std::int64_t max_steps, double tol) {
   const double dt = dem.time_step();
   const double nd = static_cast<double>(dem.size());
   for (std::int64_t k = 0; k < max_steps; ++k) {
@@ -131,16 +145,20 @@ bool relax_damped(Dem& dem, std::int64_t max_steps, double tol) {
   return false;
 }
 
-}  // namespace
-
-Packing generate_packing(const PackingParams& params) {
-  PackingReport report;
-  return generate_packing(params, report);
+// Grain measure of diameter d: disk area pi d^2 / 4 (2D), sphere volume pi d^3 / 6 (3D) [m^Dim].
+template <int Dim>
+double grain_measure(double d) {
+  if constexpr (Dim == 2)
+    return std::numbers::pi * 0.25 * d * d;
+  else
+    return std::numbers::pi / 6.0 * d * d * d;
 }
 
-Packing generate_packing(const PackingParams& p, PackingReport& report) {
-  if (auto problem = detail::check_params(p))
-    throw InputError("", 0, "packing." + problem->key, problem->expectation);
+// The protocols of §3 in Dim dimensions (the 2D path is the original disk generator).
+template <int Dim>
+Packing generate_impl(const PackingParams& p, PackingReport& report) {
+  using Dem = detail::Dem<Dim>;
+  const auto root = [](double v) { return detail::dim_root<Dim>(v); };
   const auto t_start = std::chrono::steady_clock::now();
   std::mt19937_64 rng(p.seed);
   report = PackingReport{};
@@ -152,57 +170,82 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
     for (double& di : d) di = p.diameter_min + (p.diameter_max - p.diameter_min) * uniform01(rng);
   }
   const std::size_t n = d.size();
-  double disk_area = 0.0;
-  for (double di : d) disk_area += std::numbers::pi * 0.25 * di * di;
+  double grain_volume = 0.0;
+  for (double di : d) grain_volume += grain_measure<Dim>(di);
 
   // Reference state (scale 1): the packing fraction phi_ref in the final box (§3, eq. 8).
   const bool jam = p.method == PackingMethod::kJam;
   const double phi_ref = jam ? p.jam_start_phi : p.target_phi;
-  double width = 0.0, height = 0.0, x0 = 0.0, y0 = 0.0, c = 1.0;
+  std::array<double, Dim> ext{}, lo{};  // box extents and lower corner [m]
+  double c = 1.0;
   if (p.box) {
-    x0 = (*p.box)[0];
-    y0 = (*p.box)[1];
-    width = (*p.box)[2] - x0;
-    height = (*p.box)[3] - y0;
-    c = std::sqrt(phi_ref * width * height / disk_area);
+    lo[0] = (*p.box)[0];
+    lo[1] = (*p.box)[1];
+    ext[0] = (*p.box)[2] - lo[0];
+    ext[1] = (*p.box)[3] - lo[1];
+    if constexpr (Dim == 3) {
+      lo[2] = p.box_z[0];
+      ext[2] = p.box_z[1] - lo[2];
+    }
+    double target = phi_ref;  // phi_ref x box volume [m^Dim]
+    for (int a = 0; a < Dim; ++a) target *= ext[a];
+    c = root(target / grain_volume);
     for (double& di : d) di *= c;
   } else {
-    const double area = disk_area / phi_ref;
-    width = std::sqrt(area * p.aspect_ratio);
-    height = std::sqrt(area / p.aspect_ratio);
-    x0 = p.origin[0];
-    y0 = p.origin[1];
+    const double volume = grain_volume / phi_ref;
+    if constexpr (Dim == 2) {
+      ext[0] = std::sqrt(volume * p.aspect_ratio);
+      ext[1] = std::sqrt(volume / p.aspect_ratio);
+    } else {
+      // W x W x H with W / H = aspect_ratio: H = (V / a^2)^(1/3).
+      ext[2] = std::cbrt(volume / (p.aspect_ratio * p.aspect_ratio));
+      ext[0] = ext[1] = p.aspect_ratio * ext[2];
+      lo[2] = p.origin_z;
+    }
+    lo[0] = p.origin[0];
+    lo[1] = p.origin[1];
   }
   double dbar = 0.0;
   for (double di : d) dbar += di;
   dbar /= static_cast<double>(n);
   const double dmax = *std::max_element(d.begin(), d.end());
-  // A wall box must hold the largest disk; a periodic cell must be 3 of them wide so that each
+  // A wall box must hold the largest grain; a periodic cell must be 3 of them wide so that each
   // pair interacts through one image only.
   const double fit = p.periodic ? 3.0 : 1.0;
-  if (fit * dmax >= std::min(width, height))
-    throw InputError("", 0, p.box ? "packing.box" : "packing.count",
-                     fmt::format("a box wider than {} largest disk{}: diameter {:.6g} m, box "
-                                 "{:.6g} x {:.6g} m",
-                                 p.periodic ? "3 times the" : "the", p.periodic ? "s" : "", dmax,
-                                 width, height));
+  const double ext_min = *std::min_element(ext.begin(), ext.end());
+  if (fit * dmax >= ext_min) {
+    std::string dims = fmt::format("{:.6g} x {:.6g}", ext[0], ext[1]);
+    if constexpr (Dim == 3) dims += fmt::format(" x {:.6g}", ext[2]);
+    const char* grain = Dim == 2 ? "disk" : "sphere";
+    throw InputError(
+        "", 0, p.box ? "packing.box" : "packing.count",
+        fmt::format("a box wider than {} largest {}{}: diameter {:.6g} m, box "
+                    "{} m",
+                    p.periodic ? "3 times the" : "the", grain, p.periodic ? "s" : "", dmax, dims));
+  }
 
   // Reduced units (§2): length d_mean.
-  const double wr = width / dbar, hr = height / dbar;
-  std::vector<double> r0(n), x(n), y(n);
+  std::array<double, Dim> er;  // box extents [d_mean]
+  for (int a = 0; a < Dim; ++a) er[a] = ext[a] / dbar;
+  std::vector<double> r0(n);
+  typename Dem::Coords x;
+  for (auto& xa : x) xa.assign(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) r0[i] = 0.5 * d[i] / dbar;
   const double phi0 = p.initial_phi;
-  const double s0 = std::sqrt(phi0 / phi_ref);  // radius scale at the start (grow, jam)
-  const double g0 = std::sqrt(phi_ref / phi0);  // box scale at the start (walls)
+  const double s0 = root(phi0 / phi_ref);  // radius scale at the start (grow, jam)
+  const double g0 = root(phi_ref / phi0);  // box scale at the start (walls)
   const bool walls = p.method == PackingMethod::kWalls;
-  const double bw = walls ? g0 * wr : wr, bh = walls ? g0 * hr : hr;
-  const double bx = 0.5 * (wr - bw), by = 0.5 * (hr - bh);
+  std::array<double, Dim> bw, bl;  // start box extents and lower corner [d_mean]
+  for (int a = 0; a < Dim; ++a) {
+    bw[a] = walls ? g0 * er[a] : er[a];
+    bl[a] = 0.5 * (er[a] - bw[a]);
+  }
+  const double bw_min = *std::min_element(bw.begin(), bw.end());
   const double rs = walls ? 1.0 : s0;
   for (std::size_t i = 0; i < n; ++i) {
-    // Random centers keeping each (start-size) disk inside the walls.
-    const double ri = p.periodic ? 0.0 : std::min(rs * r0[i], 0.5 * std::min(bw, bh));
-    x[i] = bx + ri + (bw - 2.0 * ri) * uniform01(rng);
-    y[i] = by + ri + (bh - 2.0 * ri) * uniform01(rng);
+    // Random centers keeping each (start-size) grain inside the walls.
+    const double ri = p.periodic ? 0.0 : std::min(rs * r0[i], 0.5 * bw_min);
+    for (int a = 0; a < Dim; ++a) x[a][i] = bl[a] + ri + (bw[a] - 2.0 * ri) * uniform01(rng);
   }
   detail::DemSettings settings;
   settings.law = p.contact_law;
@@ -210,34 +253,44 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
   settings.damping_ratio = p.damping_ratio;
   settings.global_damping = p.global_damping;
   settings.periodic = p.periodic;
-  Dem dem(std::move(x), std::move(y), std::move(r0), {bx, by, bx + bw, by + bh}, settings);
+  typename Dem::Box box0;
+  for (int a = 0; a < Dim; ++a) {
+    box0[a] = bl[a];
+    box0[Dim + a] = bl[a] + bw[a];
+  }
+  Dem dem(std::move(x), std::move(r0), box0, settings);
   dem.set_scale(rs);
 
   // Growth or wall compression with damped dynamics: phi rises linearly from phi0 to phi_ref
   // in growth_steps steps (eq. 9 and 10).
   const double dt = dem.time_step();
   const auto g_steps = p.growth_steps;
-  std::array<double, 4> box_prev = dem.box();
+  typename Dem::Box box_prev = dem.box();
   for (std::int64_t k = 1; k <= g_steps; ++k) {
     const double phi =
         phi0 + (phi_ref - phi0) * static_cast<double>(k) / static_cast<double>(g_steps);
     if (walls) {
-      const double g = std::sqrt(phi_ref / phi);
-      const std::array<double, 4> b{0.5 * wr * (1.0 - g), 0.5 * hr * (1.0 - g),
-                                    0.5 * wr * (1.0 + g), 0.5 * hr * (1.0 + g)};
+      const double g = root(phi_ref / phi);
+      typename Dem::Box b, v;
+      for (int a = 0; a < Dim; ++a) {
+        b[a] = 0.5 * er[a] * (1.0 - g);
+        b[Dim + a] = 0.5 * er[a] * (1.0 + g);
+      }
+      for (int w = 0; w < 2 * Dim; ++w) v[w] = (b[w] - box_prev[w]) / dt;
       dem.set_box(b);
-      dem.set_wall_velocity({(b[0] - box_prev[0]) / dt, (b[1] - box_prev[1]) / dt,
-                             (b[2] - box_prev[2]) / dt, (b[3] - box_prev[3]) / dt});
+      dem.set_wall_velocity(v);
       box_prev = b;
     } else {
-      dem.set_scale(std::sqrt(phi / phi_ref));
+      dem.set_scale(root(phi / phi_ref));
     }
     dem.md_step(dt);
   }
-  dem.set_wall_velocity({0.0, 0.0, 0.0, 0.0});
-  dem.set_box({0.0, 0.0, wr, hr});
+  dem.set_wall_velocity({});
+  typename Dem::Box box_ref{};
+  for (int a = 0; a < Dim; ++a) box_ref[Dim + a] = er[a];
+  dem.set_box(box_ref);
   dem.set_scale(1.0);
-  log().info("packing: {} disks, {} to phi = {:.4f} in {} steps", n,
+  log().info("packing: {} {}, {} to phi = {:.4f} in {} steps", n, Dim == 2 ? "disks" : "spheres",
              walls ? "wall compression" : "growth", phi_ref, g_steps);
 
   // Relaxation at the reference state (§4).
@@ -256,9 +309,9 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
   if (jam) {
     // Quasi-static jamming search (§4, O'Hern et al. 2003): affine compression steps of the
     // radii, each followed by a FIRE minimisation; a state is jammed when its minimised energy
-    // per disk exceeds kUnjammedEnergy. Bisection between the densest unjammed and the loosest
+    // per grain exceeds kUnjammedEnergy. Bisection between the densest unjammed and the loosest
     // jammed state until their gap < jam_phi_tolerance.
-    std::vector<double> lo_x, lo_y, hi_x, hi_y;
+    typename Dem::Coords lo_x, hi_x;
     double phi_lo = -1.0, phi_hi = -1.0, phi = phi_ref, step = 0.005;
     bool jammed = dem.energy() / static_cast<double>(n) > kUnjammedEnergy;
     bool from_lo = false;     // the last trial started from the densest unjammed state
@@ -266,11 +319,11 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
     for (int iter = 0; iter < 400; ++iter) {
       if (jammed) {
         phi_hi = phi;
-        dem.get_positions(hi_x, hi_y);
+        dem.get_positions(hi_x);
         hi_from_lo = from_lo;
       } else {
         phi_lo = phi;
-        dem.get_positions(lo_x, lo_y);
+        dem.get_positions(lo_x);
         hi_from_lo = false;
       }
       if (phi_lo > 0.0 && phi_hi > 0.0 && phi_hi - phi_lo < p.jam_phi_tolerance) {
@@ -288,11 +341,8 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
       else
         phi = phi_hi;
       from_lo = phi_lo > 0.0;
-      if (from_lo)
-        dem.set_positions(lo_x, lo_y);
-      else
-        dem.set_positions(hi_x, hi_y);
-      dem.set_scale(std::sqrt(phi / phi_ref));
+      dem.set_positions(from_lo ? lo_x : hi_x);
+      dem.set_scale(root(phi / phi_ref));
       const auto res = dem.minimize(p.max_relax_steps, 0.0, kUnjammedEnergy, kForceStop);
       jammed = res.energy_per_disk > kUnjammedEnergy;
       if (!jammed && phi >= phi_hi && phi_hi > 0.0) {
@@ -307,8 +357,8 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
     }
     report.relaxed = phi_lo > 0.0 && phi_hi > 0.0 && hi_from_lo;
     if (phi_hi > 0.0) {
-      dem.set_positions(hi_x, hi_y);
-      dem.set_scale(std::sqrt(phi_hi / phi_ref));
+      dem.set_positions(hi_x);
+      dem.set_scale(root(phi_hi / phi_ref));
       dem.update_forces(false);
       report.jamming_phi = report.relaxed ? 0.5 * (phi_lo + phi_hi) : phi_hi;
     }
@@ -320,16 +370,23 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
   const double len = p.box ? dbar : dbar / scale;
   dem.wrap();
   Packing out;
+  out.dimension = Dim;
   out.seed = p.seed;
   out.periodic = p.periodic;
-  out.xmin = x0;
-  out.ymin = y0;
-  out.xmax = p.box ? (*p.box)[2] : x0 + wr * len;
-  out.ymax = p.box ? (*p.box)[3] : y0 + hr * len;
+  out.xmin = lo[0];
+  out.ymin = lo[1];
+  out.xmax = p.box ? (*p.box)[2] : lo[0] + er[0] * len;
+  out.ymax = p.box ? (*p.box)[3] : lo[1] + er[1] * len;
+  if constexpr (Dim == 3) {
+    out.zmin = lo[2];
+    out.zmax = p.box ? p.box_z[1] : lo[2] + er[2] * len;
+  }
   out.disks.resize(n);
-  for (std::size_t i = 0; i < n; ++i)
-    out.disks[i] = Disk{static_cast<std::int64_t>(i), x0 + dem.x()[i] * len, y0 + dem.y()[i] * len,
-                        dem.r()[i] * len};
+  for (std::size_t i = 0; i < n; ++i) {
+    out.disks[i] = Disk{static_cast<std::int64_t>(i), lo[0] + dem.x(0)[i] * len,
+                        lo[1] + dem.x(1)[i] * len, dem.r()[i] * len};
+    if constexpr (Dim == 3) out.disks[i].z = lo[2] + dem.x(2)[i] * len;
+  }
   report.phi = packing_fraction(out);
   report.mean_diameter = mean_diameter(out);
   report.max_overlap = max_overlap(out) / report.mean_diameter;
@@ -345,11 +402,54 @@ Packing generate_packing(const PackingParams& p, PackingReport& report) {
   return out;
 }
 
+// Largest overlap of a packing in Dim dimensions [m], by the DEM's cell lists.
+template <int Dim>
+double max_overlap_impl(const Packing& packing) {
+  const double dbar = mean_diameter(packing);
+  if (!(dbar > 0.0)) return 0.0;
+  const std::size_t n = packing.disks.size();
+  typename detail::Dem<Dim>::Coords x;
+  for (auto& xa : x) xa.resize(n);
+  std::vector<double> r(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[0][i] = (packing.disks[i].x - packing.xmin) / dbar;
+    x[1][i] = (packing.disks[i].y - packing.ymin) / dbar;
+    if constexpr (Dim == 3) x[2][i] = (packing.disks[i].z - packing.zmin) / dbar;
+    r[i] = packing.disks[i].radius / dbar;
+  }
+  detail::DemSettings settings;
+  settings.periodic = packing.periodic;
+  typename detail::Dem<Dim>::Box box{};
+  box[Dim] = (packing.xmax - packing.xmin) / dbar;
+  box[Dim + 1] = (packing.ymax - packing.ymin) / dbar;
+  if constexpr (Dim == 3) box[5] = (packing.zmax - packing.zmin) / dbar;
+  detail::Dem<Dim> dem(std::move(x), std::move(r), box, settings);
+  dem.update_forces(false);
+  return dem.max_overlap() * dbar;
+}
+
+}  // namespace
+
+Packing generate_packing(const PackingParams& params) {
+  PackingReport report;
+  return generate_packing(params, report);
+}
+
+Packing generate_packing(const PackingParams& p, PackingReport& report) {
+  if (auto problem = detail::check_params(p))
+    throw InputError("", 0, "packing." + problem->key, problem->expectation);
+  return p.dimension == 3 ? generate_impl<3>(p, report) : generate_impl<2>(p, report);
+}
+
 double packing_fraction(const Packing& packing) {
-  double area = 0.0;
-  for (const auto& disk : packing.disks) area += std::numbers::pi * disk.radius * disk.radius;
-  const double box = (packing.xmax - packing.xmin) * (packing.ymax - packing.ymin);
-  return box > 0.0 ? area / box : 0.0;
+  const bool three = packing.dimension == 3;
+  double volume = 0.0;
+  for (const auto& disk : packing.disks)
+    volume += three ? 4.0 / 3.0 * std::numbers::pi * disk.radius * disk.radius * disk.radius
+                    : std::numbers::pi * disk.radius * disk.radius;
+  double box = (packing.xmax - packing.xmin) * (packing.ymax - packing.ymin);
+  if (three) box *= packing.zmax - packing.zmin;
+  return box > 0.0 ? volume / box : 0.0;
 }
 
 double mean_diameter(const Packing& packing) {
@@ -360,33 +460,20 @@ double mean_diameter(const Packing& packing) {
 }
 
 double max_overlap(const Packing& packing) {
-  const double dbar = mean_diameter(packing);
-  if (!(dbar > 0.0)) return 0.0;
-  const std::size_t n = packing.disks.size();
-  std::vector<double> x(n), y(n), r(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    x[i] = (packing.disks[i].x - packing.xmin) / dbar;
-    y[i] = (packing.disks[i].y - packing.ymin) / dbar;
-    r[i] = packing.disks[i].radius / dbar;
-  }
-  detail::DemSettings settings;
-  settings.periodic = packing.periodic;
-  Dem dem(std::move(x), std::move(y), std::move(r),
-          {0.0, 0.0, (packing.xmax - packing.xmin) / dbar, (packing.ymax - packing.ymin) / dbar},
-          settings);
-  dem.update_forces(false);
-  return dem.max_overlap() * dbar;
+  return packing.dimension == 3 ? max_overlap_impl<3>(packing) : max_overlap_impl<2>(packing);
 }
 
 std::string summary_line(const Packing& packing) {
   const double dbar = mean_diameter(packing);
   return fmt::format(
       "packing: {} grains, phi = {:.6f}, max overlap = {:.3e} d_mean (d_mean = {:.6g} m, {} = "
-      "[{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] m)",
+      "[{:.6g}, {:.6g}] x [{:.6g}, {:.6g}]{} m)",
       packing.disks.size(), packing_fraction(packing),
       dbar > 0.0 ? max_overlap(packing) / dbar : 0.0, dbar,
       packing.periodic ? "periodic cell" : "box", packing.xmin, packing.xmax, packing.ymin,
-      packing.ymax);
+      packing.ymax,
+      packing.dimension == 3 ? fmt::format(" x [{:.6g}, {:.6g}]", packing.zmin, packing.zmax)
+                             : std::string());
 }
 
 }  // namespace mpmcd::packing

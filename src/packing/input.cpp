@@ -154,33 +154,30 @@ class Keys {
 PackingParams packing_params_from_toml(const toml::table& table, const std::string& file,
                                        const std::string& prefix) {
   const std::int64_t table_line = line_of(table, 0);
-  const Keys k(table, file, prefix, table_line,
-               {"count",
-                "diameter_min",
-                "diameter_max",
-                "diameters",
-                "box",
-                "aspect_ratio",
-                "origin",
-                "target_phi",
-                "method",
-                "contact_law",
-                "friction",
-                "boundary",
-                "seed",
-                "initial_phi",
-                "growth_steps",
-                "max_relax_steps",
-                "overlap_tolerance",
-                "damping_ratio",
-                "global_damping",
-                "jam_start_phi",
-                "jam_phi_tolerance"});
+  const Keys k(table, file, prefix, table_line, {"dimension",       "count",
+                                                 "diameter_min",    "diameter_max",
+                                                 "diameters",       "box",
+                                                 "aspect_ratio",    "origin",
+                                                 "target_phi",      "method",
+                                                 "contact_law",     "friction",
+                                                 "boundary",        "seed",
+                                                 "initial_phi",     "growth_steps",
+                                                 "max_relax_steps", "overlap_tolerance",
+                                                 "damping_ratio",   "global_damping",
+                                                 "jam_start_phi",   "jam_phi_tolerance"});
   PackingParams p;
   const auto table_fail = [&](const std::string& what) {
     throw InputError(file, table_line, prefix, what);
   };
 
+  // Dimension first: it sets the length of box and origin and the jam_start_phi default.
+  if (k.has("dimension")) {
+    const std::int64_t dim = k.integer("dimension", 2);
+    if (dim != 2 && dim != 3)
+      k.fail("dimension", fmt::format("2 (disks) or 3 (spheres), got {}", dim));
+    p.dimension = static_cast<int>(dim);
+  }
+  const bool three = p.dimension == 3;
   const std::string method = k.choice("method", "grow", {"grow", "walls", "jam"});
   p.method = method == "grow"    ? PackingMethod::kGrow
              : method == "walls" ? PackingMethod::kWalls
@@ -217,18 +214,27 @@ PackingParams packing_params_from_toml(const toml::table& table, const std::stri
 
   // Box: given, or aspect ratio (+ origin) and the size from target_phi.
   if (k.has("box") == k.has("aspect_ratio"))
-    table_fail(
-        "exactly one of 'box' = [xmin, ymin, xmax, ymax] (m) or 'aspect_ratio' "
-        "(width / height, the size then follows from target_phi)");
+    table_fail(three ? "exactly one of 'box' = [xmin, ymin, zmin, xmax, ymax, zmax] (m) or "
+                       "'aspect_ratio' (width / height, width along x and y, height along z; the "
+                       "size then follows from target_phi)"
+                     : "exactly one of 'box' = [xmin, ymin, xmax, ymax] (m) or 'aspect_ratio' "
+                       "(width / height, the size then follows from target_phi)");
   if (k.has("box")) {
     if (k.has("origin")) k.fail("origin", "no 'origin' with 'box' (only with 'aspect_ratio')");
-    const auto b = k.numbers("box", 4, 4);
-    p.box = std::array<double, 4>{b[0], b[1], b[2], b[3]};
+    if (three) {
+      const auto b = k.numbers("box", 6, 6);
+      p.box = std::array<double, 4>{b[0], b[1], b[3], b[4]};
+      p.box_z = {b[2], b[5]};
+    } else {
+      const auto b = k.numbers("box", 4, 4);
+      p.box = std::array<double, 4>{b[0], b[1], b[2], b[3]};
+    }
   } else {
     p.aspect_ratio = k.number("aspect_ratio", p.aspect_ratio);
     if (k.has("origin")) {
-      const auto o = k.numbers("origin", 2, 2);
+      const auto o = k.numbers("origin", three ? 3 : 2, three ? 3 : 2);
       p.origin = {o[0], o[1]};
+      if (three) p.origin_z = o[2];
     }
   }
   if (p.method == PackingMethod::kJam) {
@@ -248,7 +254,8 @@ PackingParams packing_params_from_toml(const toml::table& table, const std::stri
   p.overlap_tolerance = k.number("overlap_tolerance", p.overlap_tolerance);
   p.damping_ratio = k.number("damping_ratio", p.damping_ratio);
   p.global_damping = k.number("global_damping", p.global_damping);
-  p.jam_start_phi = k.number("jam_start_phi", p.jam_start_phi);
+  // Spheres jam near 0.64 (random close packing), disks near 0.84: the search starts below.
+  p.jam_start_phi = k.number("jam_start_phi", three ? kJamStartPhi3D : p.jam_start_phi);
   p.jam_phi_tolerance = k.number("jam_phi_tolerance", p.jam_phi_tolerance);
 
   if (auto problem = detail::check_params(p)) {

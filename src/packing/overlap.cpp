@@ -2,6 +2,7 @@
 #include "mpmcd/packing/overlap.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -104,6 +105,62 @@ std::optional<Overlap> find_overlap(const std::vector<Outline>& outlines, double
     for (std::size_t j = 0; j < n; ++j)
       if (j != i) consider(i, j);
   return best;
+}
+
+std::optional<Overlap> find_sphere_overlap(const Packing& packing, double tolerance) {
+  const auto& s = packing.disks;
+  const std::size_t n = s.size();
+  if (n < 2) return std::nullopt;
+  // Cells of the largest diameter w, keyed by the cell of each sphere's lower corner: two
+  // overlapping spheres have lower corners less than w apart along each axis.
+  double w = 0.0,
+         lo[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                  std::numeric_limits<double>::infinity()};
+  for (const auto& d : s) {
+    w = std::max(w, 2.0 * d.radius);
+    lo[0] = std::min(lo[0], d.x - d.radius);
+    lo[1] = std::min(lo[1], d.y - d.radius);
+    lo[2] = std::min(lo[2], d.z - d.radius);
+  }
+  if (!(w > 0.0) || !std::isfinite(w)) return std::nullopt;
+  const auto key = [](std::int64_t ix, std::int64_t iy, std::int64_t iz) {
+    return (static_cast<std::uint64_t>(ix & 0x1fffff) << 42) ^
+           (static_cast<std::uint64_t>(iy & 0x1fffff) << 21) ^
+           static_cast<std::uint64_t>(iz & 0x1fffff);
+  };
+  std::vector<std::array<std::int64_t, 3>> c(n);
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double corner[3] = {s[i].x - s[i].radius, s[i].y - s[i].radius, s[i].z - s[i].radius};
+    for (int a = 0; a < 3; ++a)
+      c[i][a] = static_cast<std::int64_t>(std::floor((corner[a] - lo[a]) / w));
+    cells[key(c[i][0], c[i][1], c[i][2])].push_back(i);
+  }
+  std::optional<Overlap> best;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::int64_t dz = -1; dz <= 1; ++dz)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+          const auto it = cells.find(key(c[i][0] + dx, c[i][1] + dy, c[i][2] + dz));
+          if (it == cells.end()) continue;
+          for (const std::size_t j : it->second) {
+            if (j <= i) continue;
+            // Keep the pair first in (second, first) order.
+            if (best && (j > best->second || (j == best->second && i >= best->first))) continue;
+            const double depth = s[i].radius + s[j].radius -
+                                 std::sqrt((s[i].x - s[j].x) * (s[i].x - s[j].x) +
+                                           (s[i].y - s[j].y) * (s[i].y - s[j].y) +
+                                           (s[i].z - s[j].z) * (s[i].z - s[j].z));
+            const double size = 2.0 * std::min(s[i].radius, s[j].radius);
+            if (depth > tolerance * size) best = Overlap{i, j, depth, size};
+          }
+        }
+  return best;
+}
+
+std::optional<Overlap> find_grain_overlap(const Packing& packing, double tolerance) {
+  if (packing.dimension == 3) return find_sphere_overlap(packing, tolerance);
+  return find_overlap(disk_outlines(packing), tolerance);
 }
 
 std::vector<Outline> disk_outlines(const Packing& packing) {

@@ -67,13 +67,26 @@ bool parse_int(std::string_view field, Int& out) {
 
 void write_packing_csv(const Packing& packing, const std::string& path) {
   std::string text = "# mpmcd packing v1\n";
-  text += fmt::format("# box = {:.17g} {:.17g} {:.17g} {:.17g}\n", packing.xmin, packing.ymin,
-                      packing.xmax, packing.ymax);
+  if (packing.dimension == 3) {
+    // 3D: the dimension line, a six-number box and a z column (2D files are unchanged).
+    text += "# dimension = 3\n";
+    text += fmt::format("# box = {:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", packing.xmin,
+                        packing.ymin, packing.zmin, packing.xmax, packing.ymax, packing.zmax);
+  } else {
+    text += fmt::format("# box = {:.17g} {:.17g} {:.17g} {:.17g}\n", packing.xmin, packing.ymin,
+                        packing.xmax, packing.ymax);
+  }
   text += fmt::format("# seed = {}\n", packing.seed);
   if (packing.periodic) text += "# boundary = periodic\n";
-  text += "id,x,y,radius\n";
-  for (const auto& d : packing.disks)
-    text += fmt::format("{},{:.17g},{:.17g},{:.17g}\n", d.id, d.x, d.y, d.radius);
+  if (packing.dimension == 3) {
+    text += "id,x,y,z,radius\n";
+    for (const auto& d : packing.disks)
+      text += fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g}\n", d.id, d.x, d.y, d.z, d.radius);
+  } else {
+    text += "id,x,y,radius\n";
+    for (const auto& d : packing.disks)
+      text += fmt::format("{},{:.17g},{:.17g},{:.17g}\n", d.id, d.x, d.y, d.radius);
+  }
   io::write_file_atomic(path, text);
 }
 
@@ -102,9 +115,12 @@ Packing parse_packing_csv(std::string_view text, const std::string& path) {
   };
   Packing packing;
   bool has_box = false;
-  std::int64_t box_line = 0;
+  std::int64_t box_line = 0, dimension_line = 0, header_line = 0;
+  std::vector<double>
+      box;            // the numbers of the '# box =' line, checked once the dimension is known
+  int dimension = 0;  // from '# dimension =' (0: not given)
   std::vector<std::string> columns;
-  int col_id = -1, col_x = -1, col_y = -1, col_r = -1;
+  int col_id = -1, col_x = -1, col_y = -1, col_z = -1, col_r = -1;
   std::vector<std::int64_t> row_line;
   std::unordered_map<std::int64_t, std::int64_t> id_line;
   std::int64_t line_no = 0, last_line = 0;
@@ -130,22 +146,25 @@ Packing parse_packing_csv(std::string_view text, const std::string& path) {
       if (eq == std::string_view::npos) continue;
       const std::string_view key = trim(body.substr(0, eq)), value = trim(body.substr(eq + 1));
       if (key == "box") {
-        std::vector<std::string_view> f;
-        for (auto v : split(value, ' '))
-          if (!v.empty()) f.push_back(v);
-        double b[4];
-        if (f.size() != 4 || !parse_double(f[0], b[0]) || !parse_double(f[1], b[1]) ||
-            !parse_double(f[2], b[2]) || !parse_double(f[3], b[3]))
-          throw fail(line_no, "box", "'# box = xmin ymin xmax ymax' (four numbers) [m]");
-        if (!std::isfinite(b[0]) || !std::isfinite(b[1]) || !std::isfinite(b[2]) ||
-            !std::isfinite(b[3]) || !(b[2] > b[0]) || !(b[3] > b[1]))
-          throw fail(line_no, "box", "finite numbers with xmax > xmin and ymax > ymin");
-        packing.xmin = b[0];
-        packing.ymin = b[1];
-        packing.xmax = b[2];
-        packing.ymax = b[3];
+        box.clear();
+        bool numbers = true;
+        for (auto v : split(value, ' ')) {
+          if (v.empty()) continue;
+          double b = 0.0;
+          numbers = numbers && parse_double(v, b);
+          box.push_back(b);
+        }
+        if (!numbers || (box.size() != 4 && box.size() != 6))
+          throw fail(line_no, "box",
+                     "'# box = xmin ymin xmax ymax' (four numbers; 3D: xmin ymin zmin xmax ymax "
+                     "zmax) [m]");
         has_box = true;
         box_line = line_no;
+      } else if (key == "dimension") {
+        if (value != "2" && value != "3")
+          throw fail(line_no, "dimension", "2 or 3, got " + shown(value));
+        dimension = value == "3" ? 3 : 2;
+        dimension_line = line_no;
       } else if (key == "seed") {
         if (!parse_int(value, packing.seed))
           throw fail(line_no, "seed", "an integer in [0, 2^64), got " + shown(value));
@@ -168,12 +187,25 @@ Packing parse_packing_csv(std::string_view text, const std::string& path) {
         if (name == "id") col_id = ci;
         if (name == "x") col_x = ci;
         if (name == "y") col_y = ci;
+        if (name == "z") col_z = ci;
         if (name == "radius") col_r = ci;
       }
-      if (col_id < 0 || col_x < 0 || col_y < 0 || col_r < 0)
+      header_line = line_no;
+      // The dimension: the '# dimension =' line, else 3 when there is a z column.
+      if (dimension == 0) dimension = col_z >= 0 ? 3 : 2;
+      packing.dimension = dimension;
+      if (dimension == 2 && (col_id < 0 || col_x < 0 || col_y < 0 || col_r < 0))
         throw fail(
             line_no, "",
             "the column header 'id,x,y,radius' (columns id, x, y, radius), got " + shown(line));
+      if (dimension == 3 && (col_id < 0 || col_x < 0 || col_y < 0 || col_z < 0 || col_r < 0))
+        throw fail(line_no, "",
+                   fmt::format("the column header 'id,x,y,z,radius' of a 3D packing (columns id, "
+                               "x, y, z, radius{}), got {}",
+                               dimension_line > 0
+                                   ? fmt::format("; '# dimension = 3' on line {}", dimension_line)
+                                   : "",
+                               shown(line)));
       continue;
     }
     if (fields.size() != columns.size())
@@ -185,8 +217,10 @@ Packing parse_packing_csv(std::string_view text, const std::string& path) {
     Disk d;
     if (!parse_int(fields[col_id], d.id))
       throw fail(line_no, "id", "an integer, got " + shown(fields[col_id]));
-    const std::pair<int, double*> reals[3] = {{col_x, &d.x}, {col_y, &d.y}, {col_r, &d.radius}};
+    const std::pair<int, double*> reals[4] = {
+        {col_x, &d.x}, {col_y, &d.y}, {col_r, &d.radius}, {dimension == 3 ? col_z : -1, &d.z}};
     for (const auto& [col, out] : reals) {
+      if (col < 0) continue;  // z of a 2D packing
       const auto& name = columns[col];
       if (!parse_double(fields[col], *out))
         throw fail(line_no, name, "a number, got " + shown(fields[col]));
@@ -207,17 +241,48 @@ Packing parse_packing_csv(std::string_view text, const std::string& path) {
                "the column header 'id,x,y,radius' (the file has no data: empty or comments only)");
   if (packing.disks.empty()) throw fail(last_line, "", "at least one disk row after the header");
 
-  if (!has_box) {
+  const bool three = dimension == 3;
+  if (has_box) {
+    // The box has 2 x dimension numbers: lower corner, then upper corner.
+    if (box.size() != static_cast<std::size_t>(2 * dimension))
+      throw fail(box_line, "box",
+                 three ? fmt::format("'# box = xmin ymin zmin xmax ymax zmax' (six numbers, the "
+                                     "packing is 3D: line {}), got {}",
+                                     dimension_line > 0 ? dimension_line : header_line, box.size())
+                       : fmt::format("'# box = xmin ymin xmax ymax' (four numbers) [m], got {}",
+                                     box.size()));
+    bool ok = true;
+    for (double b : box) ok = ok && std::isfinite(b);
+    for (int a = 0; a < dimension; ++a) ok = ok && box[dimension + a] > box[a];
+    if (!ok)
+      throw fail(box_line, "box",
+                 three ? "finite numbers with xmax > xmin, ymax > ymin and zmax > zmin"
+                       : "finite numbers with xmax > xmin and ymax > ymin");
+    packing.xmin = box[0];
+    packing.ymin = box[1];
+    packing.xmax = box[dimension];
+    packing.ymax = box[dimension + 1];
+    if (three) {
+      packing.zmin = box[2];
+      packing.zmax = box[5];
+    }
+  } else {
     if (packing.periodic)
       throw fail(0, "box", "a '# box = xmin ymin xmax ymax' line for a periodic packing");
     // Without a box: the bounding box of the disks.
     packing.xmin = packing.ymin = std::numeric_limits<double>::infinity();
     packing.xmax = packing.ymax = -std::numeric_limits<double>::infinity();
+    packing.zmin = three ? std::numeric_limits<double>::infinity() : 0.0;
+    packing.zmax = three ? -std::numeric_limits<double>::infinity() : 0.0;
     for (const auto& d : packing.disks) {
       packing.xmin = std::min(packing.xmin, d.x - d.radius);
       packing.ymin = std::min(packing.ymin, d.y - d.radius);
       packing.xmax = std::max(packing.xmax, d.x + d.radius);
       packing.ymax = std::max(packing.ymax, d.y + d.radius);
+      if (three) {
+        packing.zmin = std::min(packing.zmin, d.z - d.radius);
+        packing.zmax = std::max(packing.zmax, d.z + d.radius);
+      }
     }
   }
   // Disks must lie in the box: centers inside, and with walls no disk may cross a wall by more
@@ -230,25 +295,37 @@ Packing parse_packing_csv(std::string_view text, const std::string& path) {
     const bool disk_in =
         packing.periodic || (d.x - slack >= packing.xmin && d.x + slack <= packing.xmax &&
                              d.y - slack >= packing.ymin && d.y + slack <= packing.ymax);
-    if (!center_in || !disk_in)
+    if (!three && (!center_in || !disk_in))
       throw fail(row_line[i], "",
                  fmt::format("disk id {} (x = {:.6g}, y = {:.6g}, radius = {:.6g}) inside the box "
                              "[{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] of line {}: it is outside",
                              d.id, d.x, d.y, d.radius, packing.xmin, packing.xmax, packing.ymin,
                              packing.ymax, box_line));
+    const bool z_in =
+        d.z >= packing.zmin && d.z <= packing.zmax &&
+        (packing.periodic || (d.z - slack >= packing.zmin && d.z + slack <= packing.zmax));
+    if (three && (!center_in || !disk_in || !z_in))
+      throw fail(
+          row_line[i], "",
+          fmt::format("sphere id {} (x = {:.6g}, y = {:.6g}, z = {:.6g}, radius = {:.6g}) "
+                      "inside the box [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] "
+                      "of line {}: it is outside",
+                      d.id, d.x, d.y, d.z, d.radius, packing.xmin, packing.xmax, packing.ymin,
+                      packing.ymax, packing.zmin, packing.zmax, box_line));
   }
   // Disks may touch but not overlap (a packing not relaxed, a duplicated row): the common area
   // would be counted twice in the volume and Phi of a run (docs/robustness.md).
-  if (const auto o = find_overlap(disk_outlines(packing), kOverlapTolerance)) {
+  if (const auto o = find_grain_overlap(packing, kOverlapTolerance)) {
     const auto& a = packing.disks[o->first];
     const auto& b = packing.disks[o->second];
+    const char* grain = three ? "sphere" : "disk";
     throw fail(row_line[o->second], "",
-               fmt::format("disk id {} to overlap no other disk (touching is fine: up to {:g} of "
-                           "the smaller diameter), but it overlaps disk id {} of line {} by "
+               fmt::format("{} id {} to overlap no other {} (touching is fine: up to {:g} of "
+                           "the smaller diameter), but it overlaps {} id {} of line {} by "
                            "{:.6g} m = {:.3g} of the smaller diameter: a duplicated row or a "
                            "packing that is not relaxed",
-                           b.id, kOverlapTolerance, a.id, row_line[o->first], o->depth,
-                           o->depth / o->size));
+                           grain, b.id, grain, kOverlapTolerance, grain, a.id, row_line[o->first],
+                           o->depth, o->depth / o->size));
   }
   return packing;
 }
@@ -257,7 +334,8 @@ void write_packing_vtu(const Packing& packing, const std::string& path) {
   const std::size_t n = packing.disks.size();
   io::VtuPointCloud cloud(n);
   // Each array is filled before the next is added: add_array may reallocate earlier storage.
-  for (std::size_t i = 0; i < n; ++i) cloud.set_position(i, packing.disks[i].x, packing.disks[i].y);
+  for (std::size_t i = 0; i < n; ++i)
+    cloud.set_position(i, packing.disks[i].x, packing.disks[i].y, packing.disks[i].z);
   {
     auto& radius = cloud.add_array("radius", 1);
     for (std::size_t i = 0; i < n; ++i) radius[i] = packing.disks[i].radius;

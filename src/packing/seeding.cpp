@@ -20,6 +20,10 @@ constexpr double kMaxPoints = 2e8;
 
 SeededPacking seed_packing(const Packing& packing, const Vec<2>& grid_origin, double cell_size,
                            int points_per_cell) {
+  if (packing.dimension != 2)
+    throw InputError("", 0, "dimension",
+                     fmt::format("a 2D packing (disks) to seed 2D grains, got a {}D packing",
+                                 packing.dimension));
   if (!std::isfinite(cell_size) || cell_size <= 0.0)
     throw InputError("", 0, "cell_size", fmt::format("a finite number > 0 [m], got {}", cell_size));
   if (points_per_cell < 1 || points_per_cell > 64)

@@ -41,4 +41,13 @@ std::optional<Overlap> find_overlap(const std::vector<Outline>& outlines, double
 /// The disks of a packing as outlines, in order.
 std::vector<Outline> disk_outlines(const Packing& packing);
 
+/// The overlapping pair of spheres of a 3D packing with depth r_a + r_b - |c_a - c_b| > tolerance
+/// * smaller diameter that comes first in (second, first) order, or none; cell lists of the
+/// largest diameter, periodic images not compared (as find_overlap).
+std::optional<Overlap> find_sphere_overlap(const Packing& packing, double tolerance);
+
+/// The overlapping pair of a packing of either dimension: find_overlap(disk_outlines(packing))
+/// in 2D, find_sphere_overlap in 3D.
+std::optional<Overlap> find_grain_overlap(const Packing& packing, double tolerance);
+
 }  // namespace mpmcd::packing

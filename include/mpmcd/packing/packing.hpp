@@ -1,6 +1,7 @@
 #pragma once
-/// Initial packings of polydisperse disks in a rectangular box: plain data, the DEM generator
-/// (docs/packing.md §1-§4), the CSV packing file (§6) and its VTU view. All lengths in metres.
+/// Initial packings of polydisperse disks (2D) or spheres (3D) in a rectangular box: plain data,
+/// the DEM generator (docs/packing.md §1-§4), the CSV packing file (§6) and its VTU view. All
+/// lengths in metres.
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -10,15 +11,17 @@
 
 namespace mpmcd::packing {
 
-/// One rigid disk of a packing.
+/// One rigid disk (2D) or sphere (3D) of a packing.
 struct Disk {
   std::int64_t id = 0;  ///< identifier, unique within a packing [-]
   double x = 0.0;       ///< center abscissa [m]
   double y = 0.0;       ///< center ordinate [m]
   double radius = 0.0;  ///< radius [m]
+  double z = 0.0;       ///< center third coordinate (3D packings; 0 in 2D) [m]
 };
 
-/// A packing: disks in the box [xmin, xmax] x [ymin, ymax].
+/// A packing: disks in the box [xmin, xmax] x [ymin, ymax] (2D), or spheres in the box
+/// [xmin, xmax] x [ymin, ymax] x [zmin, zmax] (3D).
 struct Packing {
   double xmin = 0.0;        ///< left wall [m]
   double ymin = 0.0;        ///< bottom wall [m]
@@ -27,6 +30,9 @@ struct Packing {
   std::uint64_t seed = 0;   ///< seed of the generator that made it (0 if unknown) [-]
   bool periodic = false;    ///< true: the box is a periodic cell (disks may cross its sides)
   std::vector<Disk> disks;  ///< the disks, in file order
+  int dimension = 2;        ///< 2: disks in the x-y plane, 3: spheres [-]
+  double zmin = 0.0;        ///< lower z wall (3D) [m]
+  double zmax = 0.0;        ///< upper z wall (3D) [m]
 };
 
 /// How the target packing fraction is reached (docs/packing.md §3).
@@ -44,6 +50,7 @@ enum class ContactLaw {
 
 /// Parameters of generate_packing: plain data, SI units. Defaults are those of docs/packing.md §5.
 struct PackingParams {
+  int dimension = 2;              ///< 2: disks, 3: spheres (frictionless only) [-]
   std::int64_t count = 300;       ///< number of disks when `diameters` is empty [-]
   double diameter_min = 0.0;      ///< smallest diameter of the uniform distribution [m]
   double diameter_max = 0.0;      ///< largest diameter of the uniform distribution [m]
@@ -52,10 +59,14 @@ struct PackingParams {
   /// that the packing fraction is reached in this box; if unset, the diameters are kept and the
   /// box (of `aspect_ratio`, lower corner `origin`) follows from the packing fraction.
   std::optional<std::array<double, 4>> box;
-  double aspect_ratio = 1.0;                    ///< box width / height when `box` is unset [-]
-  std::array<double, 2> origin{0.0, 0.0};       ///< lower-left corner when `box` is unset [m]
-  double target_phi = 0.78;                     ///< disk area / box area to reach (grow, walls) [-]
-  PackingMethod method = PackingMethod::kGrow;  ///< protocol
+  /// Box extent along z {zmin, zmax} [m] in 3D when `box` is set (the x-y part is `box`).
+  std::array<double, 2> box_z{0.0, 0.0};
+  /// Box width / height when `box` is unset [-]; in 3D width = x and y extents, height = z.
+  double aspect_ratio = 1.0;
+  std::array<double, 2> origin{0.0, 0.0};  ///< lower-left corner when `box` is unset [m]
+  double origin_z = 0.0;                   ///< lower z of the box in 3D when `box` is unset [m]
+  double target_phi = 0.78;  ///< disk area / box area (3D: volumes) to reach (grow, walls) [-]
+  PackingMethod method = PackingMethod::kGrow;   ///< protocol
   ContactLaw contact_law = ContactLaw::kLinear;  ///< normal force law
   double friction = 0.0;                         ///< Coulomb friction coefficient between disks [-]
   bool periodic = false;    ///< periodic cell instead of rigid walls (not with method kWalls)
@@ -84,6 +95,9 @@ struct PackingReport {
   double wall_seconds = 0.0;    ///< wall-clock time of the generation [s]
 };
 
+/// Default jam_start_phi of a 3D packing input (spheres jam near 0.64) [-].
+inline constexpr double kJamStartPhi3D = 0.55;
+
 /// Largest number of disks any reader or the generator accepts [-].
 inline constexpr std::int64_t kMaxDisks = 1'000'000;
 
@@ -93,17 +107,20 @@ Packing generate_packing(const PackingParams& params);
 /// Same, and fills `report` with the achieved packing fraction, overlaps, jamming fraction.
 Packing generate_packing(const PackingParams& params, PackingReport& report);
 
-/// Packing fraction: sum of disk areas pi r^2 / box area [-].
+/// Packing fraction: sum of disk areas pi r^2 / box area (3D: sphere volumes 4/3 pi r^3 / box
+/// volume) [-].
 double packing_fraction(const Packing& packing);
 /// Mean disk diameter [m] (0 for an empty packing).
 double mean_diameter(const Packing& packing);
-/// Largest overlap between two disks or a disk and a wall [m] (0 if none), by cell lists.
+/// Largest overlap between two disks (spheres) or one and a wall [m] (0 if none), by cell lists.
 double max_overlap(const Packing& packing);
 
-/// Writes the CSV packing file of docs/packing.md §6 (17 significant digits), atomically.
+/// Writes the CSV packing file of docs/packing.md §6 (17 significant digits), atomically; a 3D
+/// packing adds `# dimension = 3`, a six-number box and a z column.
 void write_packing_csv(const Packing& packing, const std::string& path);
 /// Reads a CSV packing file; throws InputError(file, line, column, expectation) on bad content.
-/// Without a `# box =` comment the box is the bounding box of the disks.
+/// Without a `# box =` comment the box is the bounding box of the disks. 3D when the file says
+/// `# dimension = 3` or (without a dimension line) its header has a z column.
 Packing read_packing_csv(const std::string& path);
 /// Parses the text of a CSV packing file; `path` names it in messages (throws InputError).
 Packing parse_packing_csv(std::string_view text, const std::string& path);

@@ -21,7 +21,8 @@ struct SeededPacking {
 /// inside the disk). A site inside two disks (DEM overlaps) goes to the disk with the smaller
 /// |x - c| / r (ties: lower index); each grain's point areas are then rescaled so that they sum
 /// to its disk area pi r^2. `grid_origin` [m], `cell_size` h [m], `points_per_cell` ppc [-].
-/// Throws InputError ("points_per_cell") when a disk would get no point.
+/// Throws InputError ("points_per_cell") when a disk would get no point, ("dimension") for a 3D
+/// packing.
 SeededPacking seed_packing(const Packing& packing, const Vec<2>& grid_origin, double cell_size,
                            int points_per_cell);
 

@@ -190,3 +190,36 @@ TEST(Cli, ActiveSetSolverRefusesFriction) {
   const Result ok = run("run " + input("", "").string());
   EXPECT_EQ(ok.code, 0) << ok.output;
 }
+
+// `mpmcd pack` in 3D (issue 18): a [packing] with dimension = 3 writes a sphere packing (CSV with
+// a dimension line and a z column); a bad dimension or a 2D box in 3D exits with 2 naming the
+// file, the line and the key, and writes nothing.
+TEST(Cli, PackInThreeDimensionsAndItsBadKeys) {
+  const fs::path dir = scratch("pack3d");
+  const std::string head =
+      "[packing]\ndimension = 3\ncount = 50\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+      "target_phi = 0.45\nseed = 3\n";
+  std::ofstream(dir / "pack.toml")
+      << head << "aspect_ratio = 1.0\n[output]\nfolder = \"" << (dir / "out").string() << "\"\n";
+  const Result ok = run("pack -q " + (dir / "pack.toml").string());
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_NE(ok.output.find("packing: 50 grains, phi = 0.450000"), std::string::npos) << ok.output;
+  std::ifstream csv(dir / "out" / "packing.csv");
+  const std::string text((std::istreambuf_iterator<char>(csv)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("# dimension = 3\n"), std::string::npos) << text.substr(0, 200);
+  EXPECT_NE(text.find("\nid,x,y,z,radius\n"), std::string::npos) << text.substr(0, 200);
+
+  const std::pair<std::string, std::string> bad[] = {
+      {"[packing]\ndimension = 1\ncount = 50\n",
+       "bad.toml:2: key 'packing.dimension': 2 (disks) or 3 (spheres), got 1"},
+      {head + "box = [0.0, 0.0, 0.005, 0.005]\n",
+       "bad.toml:8: key 'packing.box': an array of 6 numbers, got 4"}};
+  for (const auto& [input, message] : bad) {
+    std::ofstream(dir / "bad.toml")
+        << input << "[output]\nfolder = \"" << (dir / "bad_out").string() << "\"\n";
+    const Result r = run("pack " + (dir / "bad.toml").string());
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "bad_out"));
+  }
+}
