@@ -89,5 +89,6 @@ void EnergyLedger<Dim>::report(const mpm::Diagnostics<Dim>& d) const {
 }
 
 template class EnergyLedger<2>;
+template class EnergyLedger<3>;
 
 }  // namespace mpmcd::app

@@ -80,17 +80,17 @@ Schema build_schema() {
 
   s.add_table(
       &Config::simulation,
-      "Global settings. Only `dimension = 2` (plane strain) is supported for now; 3 is planned "
-      "and rejected with a message.",
+      "Global settings. `dimension = 2` is plane strain (grains are disks, rectangles or "
+      "packings); `dimension = 3` is 3D (grains are spheres and boxes; docs/three_d.md lists "
+      "what 3D does not have yet: packings, `[output] grains`, the coverage and Z columns).",
       {KeySpec::string("name", &SimulationSection::name,
                        "run name used in output file names (letters, digits, `_ - .`)")
            .nonempty()
            .default_of_member(),
        KeySpec::integer("dimension", &SimulationSection::dimension, "",
-                        "spatial dimension (2 = plane strain)")
+                        "spatial dimension (2 = plane strain, 3 = 3D)")
            .at_least(2)
            .at_most(3)
-           .with_note("3 not yet supported")
            .default_of_member(),
        KeySpec::integer("threads", &SimulationSection::threads, "",
                         "OpenMP threads, 0 = OpenMP default")
@@ -131,25 +131,26 @@ Schema build_schema() {
   s.add_table(
       &Config::grains,
       "One grain, a body seeded with material points, or a packing of grains read from a file. "
-      "`disk` needs `center` and `radius`; `rectangle` needs `min_corner` < `max_corner`; "
-      "`packing` needs `file` (relative to the input file's folder, must exist). Keys of other "
-      "shapes are rejected. A disk or rectangle must lie inside the grid with at least one cell "
-      "of margin on every side (ghost nodes).",
+      "`disk` (2D) and `sphere` (3D) need `center` and `radius`; `rectangle` (2D) and `box` (3D) "
+      "need `min_corner` < `max_corner`; `packing` (2D) needs `file` (relative to the input "
+      "file's folder, must exist). Keys of other shapes are rejected. A grain must lie inside "
+      "the grid with at least one cell of margin on every side (ghost nodes). A sphere is "
+      "seeded on the lattice, its points' volumes scaled to the exact 4/3 pi r^3.",
       {KeySpec::string("shape", &GrainSection::shape, "geometry of the grain")
            .require()
-           .one_of({"disk", "rectangle", "packing"}),
+           .one_of({"disk", "rectangle", "packing", "sphere", "box"}),
        KeySpec::string("material", &GrainSection::material, "name of a `[[materials]]` entry")
            .require()
            .nonempty(),
-       KeySpec::numbers("center", &GrainSection::center, "Dim", "m", "disk center")
-           .with_note("disk"),
-       KeySpec::number("radius", &GrainSection::radius, "m", "disk radius")
+       KeySpec::numbers("center", &GrainSection::center, "Dim", "m", "disk or sphere center")
+           .with_note("disk, sphere"),
+       KeySpec::number("radius", &GrainSection::radius, "m", "disk or sphere radius")
            .greater_than(0.0)
-           .with_note("disk"),
+           .with_note("disk, sphere"),
        KeySpec::numbers("min_corner", &GrainSection::min_corner, "Dim", "m", "lower corner")
-           .with_note("rectangle"),
+           .with_note("rectangle, box"),
        KeySpec::numbers("max_corner", &GrainSection::max_corner, "Dim", "m", "upper corner")
-           .with_note("rectangle"),
+           .with_note("rectangle, box"),
        KeySpec::string("file", &GrainSection::file,
                        "packing CSV file, or a packing input (.toml, docs/packing.md) generated "
                        "by DEM when the run starts; relative to the input file's folder")
@@ -162,10 +163,11 @@ Schema build_schema() {
            .default_of_member(),
        KeySpec::string("seeding", &GrainSection::seeding,
                        "where the points go: `lattice` (grid-aligned sites, spacing h / "
-                       "points_per_cell) or `polar` (disks only: concentric rings of that "
-                       "spacing, outermost point domains tangent to the circle, docs/contact.md)")
+                       "points_per_cell) or `polar` (disks and packings only: concentric rings of "
+                       "that spacing, outermost point domains tangent to the circle, "
+                       "docs/contact.md)")
            .one_of({"lattice", "polar"})
-           .defaults("polar for disk and packing, lattice for rectangle"),
+           .defaults("polar for disk and packing, lattice for rectangle, sphere and box"),
        KeySpec::subtable("initial", &GrainSection::initial, "initial velocity field")
            .defaults("at rest")});
 
@@ -181,7 +183,7 @@ Schema build_schema() {
                         "velocity gradient L, row-major")
            .defaults("zeros"),
        KeySpec::number("angular_velocity", &InitialVelocity::angular_velocity, "rad/s",
-                       "rigid spin about the grain center (2D)")
+                       "rigid spin about the grain center (2D only)")
            .default_of_member(),
        KeySpec::numbers("sine_amplitude", &InitialVelocity::sine_amplitude, "Dim", "m/s",
                         "amplitude of the sine part")
