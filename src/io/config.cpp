@@ -430,8 +430,9 @@ Schema build_schema() {
       "linearly over `ramp` and then held, until one of its end conditions. A stress-controlled "
       "wall moves along its normal at v_n = clamp(gain (sigma_measured - sigma_target), "
       "-max_speed, max_speed) (a servo; sigma_measured from the wall force of the last step over "
-      "the wall's length between its neighbours, as the `wall_<name>_stress` column), so it "
-      "needs the four walls of a box. With `[loading]`, `walls[].velocity` must be absent or "
+      "the wall's length (3D: area) between its neighbours, as the `wall_<name>_stress` column), "
+      "so it needs the four walls of a box (six in 3D). With `[loading]`, `walls[].velocity` must "
+      "be absent or "
       "zero; the walls start at rest.",
       {KeySpec::number("gain", &LoadingSection::gain, "m/(s Pa)",
                        "servo gain g (speed per stress error)")
@@ -483,7 +484,7 @@ Schema build_schema() {
       "End conditions of a stage, checked after every step; the first reached ends it. Phi, "
       "eps and a wall stress end it when they cross the value from the side they were on at the "
       "stage start (so a stage may load or unload). Phi, eps and stresses are those of the CSV "
-      "(docs/observables.md) and need the four walls of a box.",
+      "(docs/observables.md) and need the four walls of a box (six in 3D).",
       {KeySpec::number("time", &StageUntilSection::time, "s", "duration of the stage")
            .greater_than(0.0)
            .defaults("none"),
@@ -521,7 +522,7 @@ Schema build_schema() {
       &Config::stop,
       "Stop criteria of a compaction (docs/observables.md): the run stops at the first criterion "
       "reached, or at `time.end_time`, and logs which. They need four walls forming a box "
-      "(normals +x, -x, +y, -y). Checked after every step.",
+      "(normals +x, -x, +y, -y; in 3D six, with +z, -z). Checked after every step.",
       {KeySpec::number("phi", &StopSection::phi, "",
                        "stop when the solid fraction Phi = Vs/V reaches this")
            .greater_than(0.0)
@@ -558,7 +559,7 @@ Schema build_schema() {
                         "grain-scale outputs: `<name>_grains_<n>.csv` (per-grain stress, shape, "
                         "contacts) and `<name>_forces_<n>.csv` (contact forces per pair) at every "
                         "snapshot time (vtu_interval), fabric and stress columns in the CSV "
-                        "(docs/observables.md)")
+                        "(docs/observables.md); 2D only")
            .default_of_member()});
 
   s.add_table(
