@@ -294,9 +294,35 @@ double contact_threshold(std::span<const PairImpulse> pairs, const CoordinationS
 
 Coordination coordination(std::span<const ContactImpulse> contacts, std::int64_t n_grains,
                           const CoordinationSettings& settings) {
+  return coordination_of_pairs(pair_impulses(contacts, n_grains), n_grains, settings);
+}
+
+template <int Dim>
+std::vector<PairImpulse> pair_impulses(const contact::Problem<Dim>& problem,
+                                       std::int64_t n_grains) {
+  // As contact_impulses followed by pair_impulses(contacts): the same sums in the same order.
+  std::map<std::pair<std::int32_t, std::int32_t>, double> sums;
+  for (const auto& c : problem.contacts) {
+    const auto& sb = problem.slots[static_cast<std::size_t>(c.b)];
+    const std::int32_t a =
+        c.a >= 0 ? problem.slots[static_cast<std::size_t>(c.a)].grain : -1 - c.wall;
+    const std::int32_t b = sb.grain;
+    if (b < 0 || b >= n_grains || a >= n_grains || a == b) continue;
+    sums[{std::min(a, b), std::max(a, b)}] += c.impulse.dot(c.normal);
+  }
+  std::vector<PairImpulse> out;
+  out.reserve(sums.size());
+  for (const auto& [key, p] : sums) out.push_back({key.first, key.second, p});
+  return out;
+}
+
+template std::vector<PairImpulse> pair_impulses<2>(const contact::Problem<2>&, std::int64_t);
+template std::vector<PairImpulse> pair_impulses<3>(const contact::Problem<3>&, std::int64_t);
+
+Coordination coordination_of_pairs(std::span<const PairImpulse> pairs, std::int64_t n_grains,
+                                   const CoordinationSettings& settings) {
   Coordination out;
   const auto n = static_cast<std::size_t>(std::max<std::int64_t>(n_grains, 0));
-  const auto pairs = pair_impulses(contacts, n_grains);
   const double threshold = contact_threshold(pairs, settings);
   std::vector<std::pair<std::int32_t, std::int32_t>> edges;
   std::vector<int> degree(n, 0);  // contacts per grain

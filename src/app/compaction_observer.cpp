@@ -39,6 +39,16 @@ double reference_grain_area(const mpm::Model<Dim>& model) {
       per_grain_sums(model, model.points.volume0, nullptr, 0));
 }
 
+// Z of the contact network of `problem` among `grains` grains: in 2D through the per-contact
+// impulses (the association every 2D output has used), in 3D from the per-pair sums.
+template <int Dim>
+analysis::Coordination coordination_of(const contact::Problem<Dim>& problem, std::int64_t grains) {
+  if constexpr (Dim == 2)
+    return analysis::coordination(analysis::contact_impulses(problem), grains);
+  else
+    return analysis::coordination_of_pairs(analysis::pair_impulses(problem, grains), grains);
+}
+
 template <int Dim>
 Vec<Dim> force_on(const mpm::StepStats& step, std::size_t k) {
   Vec<Dim> f = Vec<Dim>::Zero();  // before the first step
@@ -98,7 +108,7 @@ std::string CompactionObserver<Dim>::csv_header() const {
     if (mp_) h += ",sigma_bottom_over_Mp";
     h += ",lw_sxx,lw_syy,lw_sxy,phi_geometric,overlap_over_Vs,outside_over_Vs,pore_diameter";
   }  // without a box: Vs is the `volume` column already
-  if (contact_ && Dim == 2) h += ",Z,Z_pairs,Z_grains,rattlers";
+  if (contact_) h += ",Z,Z_pairs,Z_grains,rattlers";
   if (config_.output.grains && Dim == 2) h += grain_csv_header(contact_);
   return h;
 }
@@ -139,11 +149,11 @@ std::string CompactionObserver<Dim>::csv_fields(const mpm::Model<Dim>& model,
                          c.outside / vs, c.pore_diameter);
     }
   }
+  if (contact_) {
+    const auto z = coordination_of(problem, grains_);
+    out += fmt::format(",{:.17g},{},{},{}", z.z, z.pairs, z.grains, z.rattlers);
+  }
   if constexpr (Dim == 2) {
-    if (contact_) {
-      const auto z = analysis::coordination(analysis::contact_impulses(problem), grains_);
-      out += fmt::format(",{:.17g},{},{},{}", z.z, z.pairs, z.grains, z.rattlers);
-    }
     if (config_.output.grains) {  // V: the box's area, else the grains' (docs/observables.md)
       const GrainSnapshot snap = grain_snapshot(model, problem, false);
       const double volume = box_ ? analysis::box_at(walls_, *box_, t).area() : grain_area(model);
@@ -176,10 +186,8 @@ double CompactionObserver<Dim>::initial_phi() const {
 template <int Dim>
 std::optional<double> CompactionObserver<Dim>::coordination(
     const contact::Problem<Dim>& problem) const {
-  if (!contact_ || Dim == 3) return std::nullopt;  // Z is 2D only (docs/three_d.md)
-  if constexpr (Dim == 2)
-    return analysis::coordination(analysis::contact_impulses(problem), grains_).z;
-  return std::nullopt;
+  if (!contact_) return std::nullopt;
+  return coordination_of(problem, grains_).z;
 }
 
 template <int Dim>

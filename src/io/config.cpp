@@ -82,7 +82,7 @@ Schema build_schema() {
       &Config::simulation,
       "Global settings. `dimension = 2` is plane strain (grains are disks, rectangles or "
       "packings); `dimension = 3` is 3D (grains are spheres and boxes; docs/three_d.md lists "
-      "what 3D does not have yet: packings, `[output] grains`, the coverage and Z columns).",
+      "what 3D does not have yet: packings, `[output] grains`, the coverage columns).",
       {KeySpec::string("name", &SimulationSection::name,
                        "run name used in output file names (letters, digits, `_ - .`)")
            .nonempty()

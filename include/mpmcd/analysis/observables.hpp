@@ -4,7 +4,8 @@
 /// fraction Φ (paper eq. (9)), wall stresses, the coordination number Z of the grain contact
 /// network and the volume-averaged (Love-Weber) stress of the grains. Pure functions on plain data.
 /// The box, Φ, ε, the wall stresses and the Love-Weber stress are given in 2D and 3D (a 3D box has
-/// two more walls, normals ±z; the height stays along y); the coverage and Z are 2D.
+/// two more walls, normals ±z; the height stays along y), and Z from pair_impulses of a 3D
+/// contact problem; the coverage and the per-contact ContactImpulse are 2D.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -156,6 +157,14 @@ struct PairImpulse {
 std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulse> contacts,
                                        std::int64_t n_grains);
 
+/// The same straight from a solved contact problem of any dimension: P·n of each contact
+/// (impulse on B along the normal from A to B) summed per pair as above.
+template <int Dim>
+std::vector<PairImpulse> pair_impulses(const contact::Problem<Dim>& problem, std::int64_t n_grains);
+
+extern template std::vector<PairImpulse> pair_impulses<2>(const contact::Problem<2>&, std::int64_t);
+extern template std::vector<PairImpulse> pair_impulses<3>(const contact::Problem<3>&, std::int64_t);
+
 /// The summed normal impulse above which a pair is in contact: settings.relative_threshold times
 /// the largest of any pair (grain-grain or grain-wall) [N s/m]; a pair is in contact when its
 /// sum exceeds this and 0.
@@ -180,5 +189,9 @@ struct Coordination {
 /// 0 if no grain is left. `n_grains` is the number of grains in the system.
 Coordination coordination(std::span<const ContactImpulse> contacts, std::int64_t n_grains,
                           const CoordinationSettings& settings = {});
+
+/// The same from the per-pair sums `pairs` (pair_impulses), e.g. of a 3D contact problem.
+Coordination coordination_of_pairs(std::span<const PairImpulse> pairs, std::int64_t n_grains,
+                                   const CoordinationSettings& settings = {});
 
 }  // namespace mpmcd::analysis

@@ -5,7 +5,7 @@
 /// and the [stop] criteria. Wires analysis/ to the model and the solver; used by run_simulation.
 /// In 3D (six walls, normals ±x, ±y, ±z) the box columns are h, width, depth, the box volume, ε,
 /// Φ, Vs, ln(Vs/Vs0), the wall stresses (force over face area) and the six Love-Weber
-/// components; the coverage and Z are 2D only.
+/// components, and Z (from the per-pair normal impulses); the coverage is 2D only.
 #include <optional>
 #include <string>
 #include <vector>
