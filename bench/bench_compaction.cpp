@@ -160,8 +160,8 @@ void BM_DenseSteps(benchmark::State& state, const std::string& path, int threads
       parallel::one_thread_fraction(rows, wall, threads, parallel::Comm::SoloReport{});
   app::CompactionObserver observer(run.config, run.model);
   const auto now = observer.now(
-      app::CompactionObserver::total_area(app::CompactionObserver::grain_areas(run.model)), {},
-      stepper.time());
+      app::CompactionObserver<2>::total_area(app::CompactionObserver<2>::grain_areas(run.model)),
+      {}, stepper.time());
   state.counters["phi"] = now ? now->phi : 0.0;
   state.counters["points"] = static_cast<double>(run.model.points.size());
   state.counters["contacts"] = contacts / steps;

@@ -12,7 +12,8 @@
 
 namespace mpmcd::analysis {
 
-GrainModuli grain_moduli(double lambda, double mu) {
+GrainModuli grain_moduli(double lambda, double mu, int dim) {
+  if (dim == 3) return {lambda + 2 * mu, lambda + 2 * mu / 3};  // K_p = λ + 2μ/3 in 3D
   return {lambda + 2 * mu, lambda + mu};  // M_p = λ + 2μ, K_p = λ + μ (2D) (paper §4)
 }
 

@@ -19,16 +19,25 @@ bool near(double a, double b) {
 
 }  // namespace
 
-std::optional<BoxWalls> find_box(std::span<const walls::Wall<2>> walls) {
-  if (walls.size() != 4) return std::nullopt;
-  int found[4] = {-1, -1, -1, -1};  // left, right, bottom, top
+namespace {
+
+// The box of 2 Dim walls with normals ±e_a (slots: -x, +x... as left, right, bottom, top, front,
+// back: normal +x, -x, +y, -y, +z, -z).
+template <int Dim>
+std::optional<BoxWalls> find_box_of(std::span<const walls::Wall<Dim>> walls) {
+  if (walls.size() != 2 * Dim) return std::nullopt;
+  int found[2 * Dim];
+  std::fill(found, found + 2 * Dim, -1);
   for (std::size_t k = 0; k < walls.size(); ++k) {
-    const Vec<2>& n = walls[k].normal;
+    const Vec<Dim>& n = walls[k].normal;
     int slot = -1;
-    if (near(n[1], 0) && near(n[0], 1)) slot = 0;
-    if (near(n[1], 0) && near(n[0], -1)) slot = 1;
-    if (near(n[0], 0) && near(n[1], 1)) slot = 2;
-    if (near(n[0], 0) && near(n[1], -1)) slot = 3;
+    for (int a = 0; a < Dim; ++a) {
+      bool others = true;
+      for (int b = 0; b < Dim; ++b)
+        if (b != a && !near(n[b], 0)) others = false;
+      if (others && near(n[a], 1)) slot = 2 * a;
+      if (others && near(n[a], -1)) slot = 2 * a + 1;
+    }
     if (slot < 0 || found[slot] >= 0) return std::nullopt;
     found[slot] = static_cast<int>(k);
   }
@@ -37,19 +46,53 @@ std::optional<BoxWalls> find_box(std::span<const walls::Wall<2>> walls) {
   b.right = static_cast<std::size_t>(found[1]);
   b.bottom = static_cast<std::size_t>(found[2]);
   b.top = static_cast<std::size_t>(found[3]);
+  if constexpr (Dim == 3) {
+    b.front = static_cast<std::size_t>(found[4]);
+    b.back = static_cast<std::size_t>(found[5]);
+  }
   return b;
 }
 
-Box box_at(std::span<const walls::Wall<2>> walls, const BoxWalls& b, double t) {
+template <int Dim>
+Box box_of(std::span<const walls::Wall<Dim>> walls, const BoxWalls& b, double t) {
   Box box;
+  box.dim = Dim;
   box.x_min = walls[b.left].point_at(t)[0];
   box.x_max = walls[b.right].point_at(t)[0];
   box.y_min = walls[b.bottom].point_at(t)[1];
   box.y_max = walls[b.top].point_at(t)[1];
+  if constexpr (Dim == 3) {
+    box.z_min = walls[b.front].point_at(t)[2];
+    box.z_max = walls[b.back].point_at(t)[2];
+  }
   return box;
 }
 
+}  // namespace
+
+std::optional<BoxWalls> find_box(std::span<const walls::Wall<2>> walls) {
+  return find_box_of<2>(walls);
+}
+
+std::optional<BoxWalls> find_box(std::span<const walls::Wall<3>> walls) {
+  return find_box_of<3>(walls);
+}
+
+Box box_at(std::span<const walls::Wall<2>> walls, const BoxWalls& b, double t) {
+  return box_of<2>(walls, b, t);
+}
+
+Box box_at(std::span<const walls::Wall<3>> walls, const BoxWalls& b, double t) {
+  return box_of<3>(walls, b, t);
+}
+
 double wall_length(const Box& box, const BoxWalls& walls, std::size_t k) {
+  if (box.dim == 3) {
+    if (k == walls.bottom || k == walls.top) return box.width() * box.depth();
+    if (k == walls.left || k == walls.right) return box.height() * box.depth();
+    if (k == walls.front || k == walls.back) return box.width() * box.height();
+    return 0.0;
+  }
   if (k == walls.bottom || k == walls.top) return box.width();
   if (k == walls.left || k == walls.right) return box.height();
   return 0.0;
@@ -65,15 +108,22 @@ CompactionState compaction_state(const Box& box, const Box& box0, double vs, dou
   return s;
 }
 
-double wall_normal_stress(const Vec<2>& force_on_wall, const Vec<2>& normal, double length) {
+template <int Dim>
+double wall_normal_stress(const Vec<Dim>& force_on_wall, const Vec<Dim>& normal, double length) {
   return force_on_wall.dot(normal) / length;  // σ = F·n / L (docs/observables.md)
 }
 
-Mat<2> love_weber_stress(const points::PointSet<2>& points, double area) {
-  Mat<2> sum = Mat<2>::Zero();
+template <int Dim>
+Mat<Dim> love_weber_stress(const points::PointSet<Dim>& points, double area) {
+  Mat<Dim> sum = Mat<Dim>::Zero();
   for (std::size_t p = 0; p < points.size(); ++p) sum += points.sigma[p] * points.volume[p];
   return sum / area;  // σ̄ = (1/V) Σ_p σ_p V_p (docs/observables.md)
 }
+
+template double wall_normal_stress<2>(const Vec<2>&, const Vec<2>&, double);
+template double wall_normal_stress<3>(const Vec<3>&, const Vec<3>&, double);
+template Mat<2> love_weber_stress<2>(const points::PointSet<2>&, double);
+template Mat<3> love_weber_stress<3>(const points::PointSet<3>&, double);
 
 Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, double pixel,
                          std::int64_t max_pixels) {
@@ -244,9 +294,35 @@ double contact_threshold(std::span<const PairImpulse> pairs, const CoordinationS
 
 Coordination coordination(std::span<const ContactImpulse> contacts, std::int64_t n_grains,
                           const CoordinationSettings& settings) {
+  return coordination_of_pairs(pair_impulses(contacts, n_grains), n_grains, settings);
+}
+
+template <int Dim>
+std::vector<PairImpulse> pair_impulses(const contact::Problem<Dim>& problem,
+                                       std::int64_t n_grains) {
+  // As contact_impulses followed by pair_impulses(contacts): the same sums in the same order.
+  std::map<std::pair<std::int32_t, std::int32_t>, double> sums;
+  for (const auto& c : problem.contacts) {
+    const auto& sb = problem.slots[static_cast<std::size_t>(c.b)];
+    const std::int32_t a =
+        c.a >= 0 ? problem.slots[static_cast<std::size_t>(c.a)].grain : -1 - c.wall;
+    const std::int32_t b = sb.grain;
+    if (b < 0 || b >= n_grains || a >= n_grains || a == b) continue;
+    sums[{std::min(a, b), std::max(a, b)}] += c.impulse.dot(c.normal);
+  }
+  std::vector<PairImpulse> out;
+  out.reserve(sums.size());
+  for (const auto& [key, p] : sums) out.push_back({key.first, key.second, p});
+  return out;
+}
+
+template std::vector<PairImpulse> pair_impulses<2>(const contact::Problem<2>&, std::int64_t);
+template std::vector<PairImpulse> pair_impulses<3>(const contact::Problem<3>&, std::int64_t);
+
+Coordination coordination_of_pairs(std::span<const PairImpulse> pairs, std::int64_t n_grains,
+                                   const CoordinationSettings& settings) {
   Coordination out;
   const auto n = static_cast<std::size_t>(std::max<std::int64_t>(n_grains, 0));
-  const auto pairs = pair_impulses(contacts, n_grains);
   const double threshold = contact_threshold(pairs, settings);
   std::vector<std::pair<std::int32_t, std::int32_t>> edges;
   std::vector<int> degree(n, 0);  // contacts per grain

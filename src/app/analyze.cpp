@@ -82,7 +82,8 @@ void read_input_copy(Run& run, std::string& name) {
                                   : "the grains have several (lambda, mu): M_p is ambiguous");
   run.lambda = used.begin()->first;
   run.mu = used.begin()->second;
-  run.moduli = analysis::grain_moduli(run.lambda, run.mu);
+  run.moduli = analysis::grain_moduli(
+      run.lambda, run.mu, static_cast<int>(root["simulation"]["dimension"].value_or(2)));
 }
 
 void analyse(Run& run, const analysis::JammingCriterion& criterion) {

@@ -151,11 +151,17 @@ int run_cli(int argc, char** argv) {
       }
     } else if (*check) {
       const io::Config cfg = io::load_config(check_input);
-      const auto model = build_model(cfg);
       // The settings' checks too (e.g. the active-set solver with friction), as `run` makes them.
-      check_walls_enclose(cfg, model, build_settings(cfg, model));
-      std::cout << fmt::format("{}: valid ({} grains, {} material points)\n", check_input,
-                               model.grains.size(), model.points.size());
+      const auto check_model = [&]<int Dim>() {
+        const auto model = build_model<Dim>(cfg);
+        check_walls_enclose(cfg, model, build_settings(cfg, model));
+        std::cout << fmt::format("{}: valid ({} grains, {} material points)\n", check_input,
+                                 model.grains.size(), model.points.size());
+      };
+      if (cfg.simulation.dimension == 3)
+        check_model.operator()<3>();
+      else
+        check_model.operator()<2>();
     } else if (*pack) {
       setup_logging(pack_quiet ? Verbosity::kQuiet : Verbosity::kNormal);
       return packing::pack_command(pack_input, pack_quiet, pack_overwrite);

@@ -14,7 +14,8 @@ namespace mpmcd::app {
 namespace {
 
 // Σ_{p in g} vol_p of each grain g (zero for grains another rank owns when `owner` is given).
-std::vector<double> per_grain_sums(const mpm::Model<2>& model, const std::vector<double>& vol,
+template <int Dim>
+std::vector<double> per_grain_sums(const mpm::Model<Dim>& model, const std::vector<double>& vol,
                                    const std::vector<int>* owner, int rank) {
   std::vector<double> sums(model.grains.size(), 0.0);
   for (std::size_t g = 0; g < sums.size(); ++g) {
@@ -25,25 +26,42 @@ std::vector<double> per_grain_sums(const mpm::Model<2>& model, const std::vector
 }
 
 // Vs = Σ_g Σ_{p in g} V_p (current volumes).
-double grain_area(const mpm::Model<2>& model) {
-  return CompactionObserver::total_area(CompactionObserver::grain_areas(model));
+template <int Dim>
+double grain_area(const mpm::Model<Dim>& model) {
+  return CompactionObserver<Dim>::total_area(CompactionObserver<Dim>::grain_areas(model));
 }
 
 // Vs0 = Σ_g Σ_{p in g} V0_p: the initial grain area, also after a restart (equal bit for bit to
 // grain_area at t = 0, where V_p = V0_p: the same association).
-double reference_grain_area(const mpm::Model<2>& model) {
-  return CompactionObserver::total_area(per_grain_sums(model, model.points.volume0, nullptr, 0));
+template <int Dim>
+double reference_grain_area(const mpm::Model<Dim>& model) {
+  return CompactionObserver<Dim>::total_area(
+      per_grain_sums(model, model.points.volume0, nullptr, 0));
 }
 
-Vec<2> force_on(const mpm::StepStats& step, std::size_t k) {
-  if (k >= step.wall_force.size()) return Vec<2>::Zero();  // before the first step
-  return Vec<2>(step.wall_force[k][0], step.wall_force[k][1]);
+// Z of the contact network of `problem` among `grains` grains: in 2D through the per-contact
+// impulses (the association every 2D output has used), in 3D from the per-pair sums.
+template <int Dim>
+analysis::Coordination coordination_of(const contact::Problem<Dim>& problem, std::int64_t grains) {
+  if constexpr (Dim == 2)
+    return analysis::coordination(analysis::contact_impulses(problem), grains);
+  else
+    return analysis::coordination_of_pairs(analysis::pair_impulses(problem, grains), grains);
+}
+
+template <int Dim>
+Vec<Dim> force_on(const mpm::StepStats& step, std::size_t k) {
+  Vec<Dim> f = Vec<Dim>::Zero();  // before the first step
+  if (k < step.wall_force.size())
+    for (int a = 0; a < Dim; ++a) f[a] = step.wall_force[k][a];
+  return f;
 }
 
 }  // namespace
 
-CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Model<2>& model)
-    : config_(config), walls_(input_walls(config)) {
+template <int Dim>
+CompactionObserver<Dim>::CompactionObserver(const io::Config& config, const mpm::Model<Dim>& model)
+    : config_(config), walls_(input_walls<Dim>(config)) {
   box_ = analysis::find_box(walls_);
   if (box_) box0_ = analysis::box_at(walls_, *box_, 0.0);
   vs0_ = reference_grain_area(model);
@@ -64,105 +82,138 @@ CompactionObserver::CompactionObserver(const io::Config& config, const mpm::Mode
         "sigma_bottom_over_Mp not written: the grains' materials do not share one P-wave and "
         "bulk modulus (M_p, K_p)");
   if (!box_ && !config.walls.empty())
-    log().info(
-        "h, eps, phi and wall stresses not written: the walls do not form a box (four "
-        "walls with normals +x, -x, +y, -y)");
+    log().info(Dim == 3
+                   ? "h, eps, phi and wall stresses not written: the walls do not form a box (six "
+                     "walls with normals +x, -x, +y, -y, +z, -z)"
+                   : "h, eps, phi and wall stresses not written: the walls do not form a box (four "
+                     "walls with normals +x, -x, +y, -y)");
 }
 
-void CompactionObserver::move_walls(const std::vector<walls::Wall<2>>& walls) {
+template <int Dim>
+void CompactionObserver<Dim>::move_walls(const std::vector<walls::Wall<Dim>>& walls) {
   for (std::size_t k = 0; k < walls_.size() && k < walls.size(); ++k) walls_[k] = walls[k];
 }
 
-std::string CompactionObserver::csv_header() const {
+template <int Dim>
+std::string CompactionObserver<Dim>::csv_header() const {
   std::string h;
-  if (box_) {
+  if (box_ && Dim == 3) {  // no coverage raster in 3D (docs/three_d.md)
+    h += ",h,width,depth,box_volume,eps,phi,Vs,ln_Vs_Vs0";
+    for (const auto& w : config_.walls) h += ",wall_" + w.name + "_stress";
+    if (mp_) h += ",sigma_bottom_over_Mp";
+    h += ",lw_sxx,lw_syy,lw_szz,lw_sxy,lw_sxz,lw_syz";
+  } else if (box_) {
     h += ",h,width,box_area,eps,phi,Vs,ln_Vs_Vs0";
     for (const auto& w : config_.walls) h += ",wall_" + w.name + "_stress";
     if (mp_) h += ",sigma_bottom_over_Mp";
     h += ",lw_sxx,lw_syy,lw_sxy,phi_geometric,overlap_over_Vs,outside_over_Vs,pore_diameter";
   }  // without a box: Vs is the `volume` column already
   if (contact_) h += ",Z,Z_pairs,Z_grains,rattlers";
-  if (config_.output.grains) h += grain_csv_header(contact_);
+  if (config_.output.grains && Dim == 2) h += grain_csv_header(contact_);
   return h;
 }
 
-std::string CompactionObserver::csv_fields(const mpm::Model<2>& model, const mpm::StepStats& step,
-                                           const contact::Problem<2>& problem, double t) const {
+template <int Dim>
+std::string CompactionObserver<Dim>::csv_fields(const mpm::Model<Dim>& model,
+                                                const mpm::StepStats& step,
+                                                const contact::Problem<Dim>& problem,
+                                                double t) const {
   std::string out;
   if (box_) {
     const double vs = grain_area(model);
     const analysis::Box box = analysis::box_at(walls_, *box_, t);
     const auto s = analysis::compaction_state(box, box0_, vs, vs0_);
-    out += fmt::format(",{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.height,
-                       box.width(), box.area(), s.strain, s.phi, s.vs, s.ln_vs_vs0);
+    if constexpr (Dim == 3)
+      out +=
+          fmt::format(",{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.height,
+                      box.width(), box.depth(), box.area(), s.strain, s.phi, s.vs, s.ln_vs_vs0);
+    else
+      out += fmt::format(",{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.height,
+                         box.width(), box.area(), s.strain, s.phi, s.vs, s.ln_vs_vs0);
     double bottom = 0;
     for (std::size_t k = 0; k < walls_.size(); ++k) {
-      const double sigma = analysis::wall_normal_stress(force_on(step, k), walls_[k].normal,
+      const double sigma = analysis::wall_normal_stress(force_on<Dim>(step, k), walls_[k].normal,
                                                         analysis::wall_length(box, *box_, k));
       if (k == box_->bottom) bottom = sigma;
       out += fmt::format(",{:.12e}", sigma);
     }
     if (mp_) out += fmt::format(",{:.12e}", bottom / *mp_);
-    const Mat<2> lw = analysis::love_weber_stress(model.points, box.area());
-    out += fmt::format(",{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1), lw(0, 1));
-    const auto c = analysis::domain_coverage(model.points, box, pixel_);
-    out += fmt::format(",{:.8e},{:.8e},{:.8e},{:.8e}", 1.0 - c.pores / box.area(), c.overlap / vs,
-                       c.outside / vs, c.pore_diameter);
+    const Mat<Dim> lw = analysis::love_weber_stress(model.points, box.area());
+    if constexpr (Dim == 3) {
+      out += fmt::format(",{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1),
+                         lw(2, 2), lw(0, 1), lw(0, 2), lw(1, 2));
+    } else {
+      out += fmt::format(",{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1), lw(0, 1));
+      const auto c = analysis::domain_coverage(model.points, box, pixel_);
+      out += fmt::format(",{:.8e},{:.8e},{:.8e},{:.8e}", 1.0 - c.pores / box.area(), c.overlap / vs,
+                         c.outside / vs, c.pore_diameter);
+    }
   }
   if (contact_) {
-    const auto z = analysis::coordination(analysis::contact_impulses(problem), grains_);
+    const auto z = coordination_of(problem, grains_);
     out += fmt::format(",{:.17g},{},{},{}", z.z, z.pairs, z.grains, z.rattlers);
   }
-  if (config_.output.grains) {  // V: the box's area, else the grains' (docs/observables.md)
-    const GrainSnapshot snap = grain_snapshot(model, problem, false);
-    const double volume = box_ ? analysis::box_at(walls_, *box_, t).area() : grain_area(model);
-    out += grain_csv_fields(snap, volume, contact_);
+  if constexpr (Dim == 2) {
+    if (config_.output.grains) {  // V: the box's area, else the grains' (docs/observables.md)
+      const GrainSnapshot snap = grain_snapshot(model, problem, false);
+      const double volume = box_ ? analysis::box_at(walls_, *box_, t).area() : grain_area(model);
+      out += grain_csv_fields(snap, volume, contact_);
+    }
+  } else {
+    (void)problem;
   }
   return out;
 }
 
-std::optional<CompactionObserver::Now> CompactionObserver::now(double grain_area,
-                                                               const mpm::StepStats& step,
-                                                               double t) const {
+template <int Dim>
+std::optional<typename CompactionObserver<Dim>::Now> CompactionObserver<Dim>::now(
+    double grain_area, const mpm::StepStats& step, double t) const {
   if (!box_) return std::nullopt;
   const analysis::Box box = analysis::box_at(walls_, *box_, t);
   const auto s = analysis::compaction_state(box, box0_, grain_area, vs0_);
   const auto stress = [&](std::size_t k) {
-    return analysis::wall_normal_stress(force_on(step, k), walls_[k].normal,
+    return analysis::wall_normal_stress(force_on<Dim>(step, k), walls_[k].normal,
                                         analysis::wall_length(box, *box_, k));
   };
   return Now{s.phi, std::fabs(s.strain), stress(box_->bottom), stress(box_->top)};
 }
 
-double CompactionObserver::initial_phi() const {
+template <int Dim>
+double CompactionObserver<Dim>::initial_phi() const {
   return box_ && box0_.area() > 0 ? vs0_ / box0_.area() : 0.0;
 }
 
-std::optional<double> CompactionObserver::coordination(const contact::Problem<2>& problem) const {
+template <int Dim>
+std::optional<double> CompactionObserver<Dim>::coordination(
+    const contact::Problem<Dim>& problem) const {
   if (!contact_) return std::nullopt;
-  return analysis::coordination(analysis::contact_impulses(problem), grains_).z;
+  return coordination_of(problem, grains_).z;
 }
 
-std::vector<double> CompactionObserver::grain_areas(const mpm::Model<2>& model,
-                                                    const std::vector<int>* owner, int rank) {
+template <int Dim>
+std::vector<double> CompactionObserver<Dim>::grain_areas(const mpm::Model<Dim>& model,
+                                                         const std::vector<int>* owner, int rank) {
   return per_grain_sums(model, model.points.volume, owner, rank);
 }
 
-double CompactionObserver::total_area(const std::vector<double>& areas) {
+template <int Dim>
+double CompactionObserver<Dim>::total_area(const std::vector<double>& areas) {
   double vs = 0;
   for (double a : areas) vs += a;
   return vs;
 }
 
-std::optional<std::string> CompactionObserver::stop_reason(const mpm::Model<2>& model,
-                                                           const mpm::StepStats& step,
-                                                           double t) const {
+template <int Dim>
+std::optional<std::string> CompactionObserver<Dim>::stop_reason(const mpm::Model<Dim>& model,
+                                                                const mpm::StepStats& step,
+                                                                double t) const {
   return stop_reason(grain_area(model), step, t);
 }
 
-std::optional<std::string> CompactionObserver::stop_reason(double grain_area,
-                                                           const mpm::StepStats& step,
-                                                           double t) const {
+template <int Dim>
+std::optional<std::string> CompactionObserver<Dim>::stop_reason(double grain_area,
+                                                                const mpm::StepStats& step,
+                                                                double t) const {
   const auto& c = config_.stop;
   if (!box_ || (c.phi <= 0 && c.strain <= 0 && c.stress <= 0)) return std::nullopt;
   const analysis::Box box = analysis::box_at(walls_, *box_, t);
@@ -172,13 +223,17 @@ std::optional<std::string> CompactionObserver::stop_reason(double grain_area,
   if (c.strain > 0 && std::fabs(s.strain) >= c.strain)
     return fmt::format("stop.strain reached: |eps| = {:.6f} >= {}", std::fabs(s.strain), c.strain);
   if (c.stress > 0) {
-    const double sigma = analysis::wall_normal_stress(force_on(step, box_->bottom),
-                                                      walls_[box_->bottom].normal, box.width());
+    const double sigma = analysis::wall_normal_stress(
+        force_on<Dim>(step, box_->bottom), walls_[box_->bottom].normal,
+        Dim == 3 ? analysis::wall_length(box, *box_, box_->bottom) : box.width());
     if (-sigma >= c.stress)
       return fmt::format("stop.stress reached: bottom wall stress -sigma = {:.6g} Pa >= {} Pa",
                          -sigma, c.stress);
   }
   return std::nullopt;
 }
+
+template class CompactionObserver<2>;
+template class CompactionObserver<3>;
 
 }  // namespace mpmcd::app

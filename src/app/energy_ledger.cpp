@@ -71,23 +71,25 @@ std::string EnergyLedger<Dim>::csv_fields(const mpm::Diagnostics<Dim>& d) const 
 template <int Dim>
 void EnergyLedger<Dim>::report(const mpm::Diagnostics<Dim>& d) const {
   const EnergyTerms l = terms(d);
+  constexpr const char* kUnit = Dim == 3 ? "J" : "J/m";  // 2D: per unit thickness
   const double in = l.walls + sums_.body_work;
   const auto pct = [&](double x) { return in != 0 ? 100 * x / std::abs(in) : 0.0; };
   log().info(
-      "energy: walls and body forces did {:.6g} J/m of work, elastic + kinetic changed by "
-      "{:.6g} J/m; dissipated by contact {:.3g} %, by the transfers {:.3g} %, in the bulk "
+      "energy: walls and body forces did {:.6g} {} of work, elastic + kinetic changed by "
+      "{:.6g} {}; dissipated by contact {:.3g} %, by the transfers {:.3g} %, in the bulk "
       "(stress work not stored) {:.3g} %; unaccounted {:.3g} % of the work",
-      in, l.change, pct(sums_.contact_dissipation), pct(sums_.transfer_dissipation),
+      in, kUnit, l.change, kUnit, pct(sums_.contact_dissipation), pct(sums_.transfer_dissipation),
       pct(l.internal), pct(l.rest));
   const double scale = std::max({std::abs(in), std::abs(l.change), 1e-300});
   if (std::abs(l.rest) > kLedgerTolerance * scale)
     log().warn(
-        "the energy ledger does not close: {:.6g} J/m ({:.3g} % of the work) is unaccounted; "
+        "the energy ledger does not close: {:.6g} {} ({:.3g} % of the work) is unaccounted; "
         "prescribed grid velocities ([[boundary]]) do work the ledger does not count, and loose "
         "Newton or Gauss-Seidel tolerances leave a remainder (docs/accuracy.md)",
-        l.rest, 100 * std::abs(l.rest) / scale);
+        l.rest, kUnit, 100 * std::abs(l.rest) / scale);
 }
 
 template class EnergyLedger<2>;
+template class EnergyLedger<3>;
 
 }  // namespace mpmcd::app

@@ -1,6 +1,7 @@
 #include "mpmcd/app/model_builder.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,23 +24,33 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Vec<2> vec2(const std::vector<double>& v) {
-  return Vec<2>(v.at(0), v.at(1));
+// The Dim components of an input array (checked by the schema to have Dim entries).
+template <int Dim>
+Vec<Dim> vec_of(const std::vector<double>& v) {
+  Vec<Dim> out;
+  for (int a = 0; a < Dim; ++a) out[a] = v.at(static_cast<std::size_t>(a));
+  return out;
 }
 
-// v(x) = velocity + gradient (x - c) + omega e_z x (x - c) + A sin(k . x + phase) (InitialVelocity)
-Vec<2> initial_velocity(const io::InitialVelocity& iv, const Vec<2>& c, const Vec<2>& x) {
-  Vec<2> v = Vec<2>::Zero();
-  if (iv.velocity.size() == 2) v += vec2(iv.velocity);
-  if (iv.gradient.size() == 4) {
-    Mat<2> L;
-    L << iv.gradient[0], iv.gradient[1], iv.gradient[2], iv.gradient[3];
+// v(x) = velocity + gradient (x - c) + omega e_z x (x - c) + A sin(k . x + phase) (InitialVelocity;
+// the spin is 2D only, refused by the input in 3D)
+template <int Dim>
+Vec<Dim> initial_velocity(const io::InitialVelocity& iv, const Vec<Dim>& c, const Vec<Dim>& x) {
+  Vec<Dim> v = Vec<Dim>::Zero();
+  if (iv.velocity.size() == Dim) v += vec_of<Dim>(iv.velocity);
+  if (iv.gradient.size() == Dim * Dim) {
+    Mat<Dim> L;
+    for (int a = 0; a < Dim; ++a)
+      for (int b = 0; b < Dim; ++b) L(a, b) = iv.gradient[static_cast<std::size_t>(a * Dim + b)];
     v += L * (x - c);
   }
-  const Vec<2> r = x - c;
-  v += iv.angular_velocity * Vec<2>(-r[1], r[0]);
-  if (iv.sine_amplitude.size() == 2 && iv.sine_wavevector.size() == 2)
-    v += vec2(iv.sine_amplitude) * std::sin(vec2(iv.sine_wavevector).dot(x) + iv.sine_phase);
+  if constexpr (Dim == 2) {
+    const Vec<2> r = x - c;
+    v += iv.angular_velocity * Vec<2>(-r[1], r[0]);
+  }
+  if (iv.sine_amplitude.size() == Dim && iv.sine_wavevector.size() == Dim)
+    v += vec_of<Dim>(iv.sine_amplitude) *
+         std::sin(vec_of<Dim>(iv.sine_wavevector).dot(x) + iv.sine_phase);
   return v;
 }
 
@@ -160,6 +171,47 @@ void check_no_overlap(const io::Config& cfg, const Outlines& outlines) {
                   o->depth / o->size));
 }
 
+// The 3D grains (spheres and boxes, in input order) may touch but not overlap: the depth of the
+// deepest overlap of a pair, above packing::kOverlapTolerance of the smaller one's size, is
+// refused as check_no_overlap does in 2D.
+struct Solid3 {
+  Vec<3> lo, hi;        // box corners [m] (a sphere: its center in lo, hi unused)
+  double radius = 0.0;  // sphere radius, 0 for a box [m]
+};
+
+void check_no_overlap_3d(const io::Config& cfg, const std::vector<Solid3>& solids) {
+  const auto size = [](const Solid3& s) {
+    return s.radius > 0 ? 2 * s.radius : (s.hi - s.lo).minCoeff();
+  };
+  for (std::size_t j = 0; j < solids.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i) {
+      const Solid3 &a = solids[i], &b = solids[j];
+      double depth = 0;  // how far the two interpenetrate [m]
+      if (a.radius > 0 && b.radius > 0) {
+        depth = a.radius + b.radius - (a.lo - b.lo).norm();
+      } else if (a.radius > 0 || b.radius > 0) {
+        const Solid3& ball = a.radius > 0 ? a : b;
+        const Solid3& box = a.radius > 0 ? b : a;
+        const Vec<3> c = ball.lo;
+        const Vec<3> nearest = c.cwiseMax(box.lo).cwiseMin(box.hi);
+        const bool inside = ((c.array() > box.lo.array()) && (c.array() < box.hi.array())).all();
+        depth = inside ? ball.radius : ball.radius - (c - nearest).norm();
+      } else {
+        depth = (a.hi.cwiseMin(b.hi) - a.lo.cwiseMax(b.lo)).minCoeff();
+      }
+      const double smaller = std::min(size(a), size(b));
+      if (depth > packing::kOverlapTolerance * smaller)
+        throw InputError(
+            cfg.source_path, cfg.grains[j].line, fmt::format("grains[{}]", j),
+            fmt::format("grains that touch but do not overlap (up to {:g} of the smaller one's "
+                        "diameter or side): grains[{}] (line {}) overlaps grains[{}] (line {}) by "
+                        "{:.6g} m = {:.3g} of the smaller size (their common volume would be "
+                        "counted twice in the volume and Phi)",
+                        packing::kOverlapTolerance, j, cfg.grains[j].line, i, cfg.grains[i].line,
+                        depth, depth / smaller));
+    }
+}
+
 }  // namespace
 
 template <int Dim>
@@ -184,32 +236,46 @@ mpm::Model<Dim> model_frame(const io::Config& cfg) {
 }
 
 template mpm::Model<2> model_frame<2>(const io::Config&);
+template mpm::Model<3> model_frame<3>(const io::Config&);
 
-mpm::Model<2> build_model(const io::Config& cfg) {
-  mpm::Model<2> model = model_frame<2>(cfg);
+template <int Dim>
+mpm::Model<Dim> build_model(const io::Config& cfg) {
+  if (cfg.simulation.dimension != Dim)
+    throw InputError(
+        cfg.source_path, 0, "simulation.dimension",
+        fmt::format("a {}D model asked of a dimension {} input", Dim, cfg.simulation.dimension));
+  mpm::Model<Dim> model = model_frame<Dim>(cfg);
   const double h = cfg.grid.cell_size;
-  Outlines outlines;
+  Outlines outlines;             // 2D
+  std::vector<Solid3> solids3d;  // 3D
   for (std::size_t i = 0; i < cfg.grains.size(); ++i) {
     const auto& g = cfg.grains[i];
     int material = -1;
     for (std::size_t k = 0; k < cfg.materials.size(); ++k)
       if (cfg.materials[k].name == g.material) material = static_cast<int>(k);
-    points::Seeds<2> seeds;
-    Vec<2> center;
-    if (g.shape == "disk") {
-      center = vec2(g.center);
-      outlines.shapes.push_back({center[0], center[1], 0.0, 0.0, g.radius});
-      seeds =
-          g.seeding == "polar"
-              ? points::seed_disk_polar(center, g.radius, h / g.points_per_cell)
-              : points::seed_ball<2>(model.grid.origin(), h, g.points_per_cell, center, g.radius);
-    } else if (g.shape == "rectangle") {
-      const Vec<2> lo = vec2(g.min_corner), hi = vec2(g.max_corner);
+    points::Seeds<Dim> seeds;
+    Vec<Dim> center;
+    if (g.shape == "disk" || g.shape == "sphere") {  // the input allows each in its dimension
+      center = vec_of<Dim>(g.center);
+      if constexpr (Dim == 2) {
+        outlines.shapes.push_back({center[0], center[1], 0.0, 0.0, g.radius});
+        if (g.seeding == "polar")
+          seeds = points::seed_disk_polar(center, g.radius, h / g.points_per_cell);
+      } else {
+        solids3d.push_back({center, center, g.radius});
+      }
+      if (g.seeding != "polar")
+        seeds = points::seed_ball<Dim>(model.grid.origin(), h, g.points_per_cell, center, g.radius);
+    } else if (g.shape == "rectangle" || g.shape == "box") {
+      const Vec<Dim> lo = vec_of<Dim>(g.min_corner), hi = vec_of<Dim>(g.max_corner);
       center = 0.5 * (lo + hi);
-      outlines.shapes.push_back({lo[0], lo[1], hi[0], hi[1], 0.0});
-      seeds = points::seed_box<2>(model.grid.origin(), h, g.points_per_cell, lo, hi);
-    } else if (g.shape == "packing") {
-      add_packing_grains(model, cfg, i, material, outlines);
+      if constexpr (Dim == 2)
+        outlines.shapes.push_back({lo[0], lo[1], hi[0], hi[1], 0.0});
+      else
+        solids3d.push_back({lo, hi, 0.0});
+      seeds = points::seed_box<Dim>(model.grid.origin(), h, g.points_per_cell, lo, hi);
+    } else if (g.shape == "packing" && Dim == 2) {
+      if constexpr (Dim == 2) add_packing_grains(model, cfg, i, material, outlines);
       continue;
     } else {
       throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].shape", i),
@@ -221,55 +287,85 @@ mpm::Model<2> build_model(const io::Config& cfg) {
                        "the grain is too small to hold a material point at this cell size and "
                        "points_per_cell: refine the grid or raise points_per_cell");
     model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
-                    [&](const Vec<2>& x) { return initial_velocity(g.initial, center, x); });
+                    [&](const Vec<Dim>& x) { return initial_velocity<Dim>(g.initial, center, x); });
   }
-  check_no_overlap(cfg, outlines);
+  if constexpr (Dim == 2)
+    check_no_overlap(cfg, outlines);
+  else
+    check_no_overlap_3d(cfg, solids3d);
   return model;
 }
 
-std::vector<mpm::VelocityBC<2>> build_boundaries(const io::Config& cfg, const grid::Grid<2>& grid,
-                                                 double t) {
-  std::vector<mpm::VelocityBC<2>> out;
+template mpm::Model<2> build_model<2>(const io::Config&);
+template mpm::Model<3> build_model<3>(const io::Config&);
+
+template <int Dim>
+std::vector<mpm::VelocityBC<Dim>> build_boundaries(const io::Config& cfg,
+                                                   const grid::Grid<Dim>& grid, double t) {
+  std::vector<mpm::VelocityBC<Dim>> out;
   const auto& n = grid.nodes_per_axis();
   const double h = grid.cell_size();
   for (const auto& b : cfg.boundaries) {
-    mpm::VelocityBC<2> bc;
-    for (const auto& f : b.fix) bc.mask |= static_cast<std::uint8_t>(1u << (f == "x" ? 0 : 1));
-    bc.velocity = vec2(b.velocity);
-    IVec<2> lo = IVec<2>::Zero(), hi = n - IVec<2>::Ones();
+    mpm::VelocityBC<Dim> bc;
+    for (const auto& f : b.fix)
+      bc.mask |= static_cast<std::uint8_t>(1u << (f == "x" ? 0 : f == "y" ? 1 : 2));
+    bc.velocity = vec_of<Dim>(b.velocity);
+    IVec<Dim> lo = IVec<Dim>::Zero(), hi = n - IVec<Dim>::Ones();
     if (b.nodes == "xmin") hi[0] = 0;
     if (b.nodes == "xmax") lo[0] = n[0] - 1;
     if (b.nodes == "ymin") hi[1] = 0;
     if (b.nodes == "ymax") lo[1] = n[1] - 1;
+    if constexpr (Dim == 3) {
+      if (b.nodes == "zmin") hi[2] = 0;
+      if (b.nodes == "zmax") lo[2] = n[2] - 1;
+    }
     if (b.nodes == "box") {
-      const Vec<2> shift = b.moving ? Vec<2>(t * bc.velocity) : Vec<2>::Zero();
-      for (int d = 0; d < 2; ++d) {
+      const Vec<Dim> shift = b.moving ? Vec<Dim>(t * bc.velocity) : Vec<Dim>::Zero();
+      for (int d = 0; d < Dim; ++d) {
         const double a = (b.box_min[d] + shift[d] - grid.origin()[d]) / h;
         const double z = (b.box_max[d] + shift[d] - grid.origin()[d]) / h;
         lo[d] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a - 1e-9)));
         hi[d] = std::min<std::int64_t>(n[d] - 1, static_cast<std::int64_t>(std::floor(z + 1e-9)));
       }
     }
-    for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
-      for (std::int64_t i = lo[0]; i <= hi[0]; ++i) bc.nodes.push_back(grid.node_index({i, j}));
+    if constexpr (Dim == 2) {
+      for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+        for (std::int64_t i = lo[0]; i <= hi[0]; ++i) bc.nodes.push_back(grid.node_index({i, j}));
+    } else {
+      for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
+        for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+          for (std::int64_t i = lo[0]; i <= hi[0]; ++i)
+            bc.nodes.push_back(grid.node_index({i, j, k}));
+    }
     out.push_back(std::move(bc));
   }
   return out;
 }
 
+template std::vector<mpm::VelocityBC<2>> build_boundaries<2>(const io::Config&,
+                                                             const grid::Grid<2>&, double);
+template std::vector<mpm::VelocityBC<3>> build_boundaries<3>(const io::Config&,
+                                                             const grid::Grid<3>&, double);
+
 bool contact_enabled(const io::Config& cfg, std::size_t grains) {
   return cfg.contact.enabled && (grains > 1 || !cfg.walls.empty());
 }
 
-std::vector<walls::Wall<2>> input_walls(const io::Config& cfg) {
-  std::vector<walls::Wall<2>> out;
+template <int Dim>
+std::vector<walls::Wall<Dim>> input_walls(const io::Config& cfg) {
+  std::vector<walls::Wall<Dim>> out;
   for (const auto& w : cfg.walls)
-    out.push_back({w.name, vec2(w.point), vec2(w.normal), vec2(w.velocity), w.friction});
+    out.push_back(
+        {w.name, vec_of<Dim>(w.point), vec_of<Dim>(w.normal), vec_of<Dim>(w.velocity), w.friction});
   return out;
 }
 
-mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& model) {
-  mpm::Settings<2> s;
+template std::vector<walls::Wall<2>> input_walls<2>(const io::Config&);
+template std::vector<walls::Wall<3>> input_walls<3>(const io::Config&);
+
+template <int Dim>
+mpm::Settings<Dim> build_settings(const io::Config& cfg, const mpm::Model<Dim>& model) {
+  mpm::Settings<Dim> s;
   s.shape = grid::shape_kind_from_string(cfg.grid.shape_function);
   s.theta = cfg.time.theta;
   s.max_iterations = cfg.solver.max_iterations;
@@ -281,7 +377,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
   s.flip = cfg.solver.flip;
   s.affine = cfg.solver.affine;
   s.modified_newton = cfg.solver.modified_newton;
-  if (cfg.loads.gravity.size() == 2) s.gravity = vec2(cfg.loads.gravity);
+  if (cfg.loads.gravity.size() == Dim) s.gravity = vec_of<Dim>(cfg.loads.gravity);
   auto& c = s.contact;
   c.enabled = contact_enabled(cfg, model.grains.size());
   c.criterion =
@@ -318,7 +414,7 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
     const int a = index(p.materials[0]), b = index(p.materials[1]);
     c.friction[a * nm + b] = c.friction[b * nm + a] = p.friction;
   }
-  c.walls = input_walls(cfg);
+  c.walls = input_walls<Dim>(cfg);
   c.law = cfg.contact.law;
   const contact::ContactLaw& law = contact::find_contact_law(c.law);
   if (c.active_set && !law.active_set)
@@ -348,18 +444,28 @@ mpm::Settings<2> build_settings(const io::Config& cfg, const mpm::Model<2>& mode
   return s;
 }
 
-void check_walls_enclose(const io::Config& cfg, const mpm::Model<2>& model,
-                         const mpm::Settings<2>& settings) {
+template mpm::Settings<2> build_settings<2>(const io::Config&, const mpm::Model<2>&);
+template mpm::Settings<3> build_settings<3>(const io::Config&, const mpm::Model<3>&);
+
+template <int Dim>
+void check_walls_enclose(const io::Config& cfg, const mpm::Model<Dim>& model,
+                         const mpm::Settings<Dim>& settings) {
   for (std::size_t k = 0; k < settings.contact.walls.size(); ++k) {
     const auto& wall = settings.contact.walls[k];
     for (std::size_t p = 0; p < model.points.size(); ++p)
       if (wall.distance(model.points.x[p], 0.0) < 0.0)
-        throw InputError(cfg.source_path, cfg.walls[k].line, fmt::format("walls[{}]", k),
-                         fmt::format("wall \"{}\" does not enclose the grains: grain {} has a "
-                                     "material point at ({:.6g}, {:.6g}) m on its outer side",
-                                     wall.name, model.points.grain[p], model.points.x[p][0],
-                                     model.points.x[p][1]));
+        throw InputError(
+            cfg.source_path, cfg.walls[k].line, fmt::format("walls[{}]", k),
+            fmt::format("wall \"{}\" does not enclose the grains: grain {} has a "
+                        "material point at ({:.6g}) m on its outer side",
+                        wall.name, model.points.grain[p],
+                        fmt::join(model.points.x[p].data(), model.points.x[p].data() + Dim, ", ")));
   }
 }
+
+template void check_walls_enclose<2>(const io::Config&, const mpm::Model<2>&,
+                                     const mpm::Settings<2>&);
+template void check_walls_enclose<3>(const io::Config&, const mpm::Model<3>&,
+                                     const mpm::Settings<3>&);
 
 }  // namespace mpmcd::app

@@ -18,7 +18,8 @@ namespace mpmcd::app {
 
 namespace fs = std::filesystem;
 
-void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {
+template <int Dim>
+void write_points_vtu(const mpm::Model<Dim>& model, const std::string& path) {
   const auto& p = model.points;
   io::VtuPointCloud vtu(p.size());
   auto& vel = vtu.add_array("velocity", 3);
@@ -28,27 +29,33 @@ void write_points_vtu(const mpm::Model<2>& model, const std::string& path) {
   auto& mass = vtu.add_array("mass", 1);
   auto& vol = vtu.add_array("volume", 1);
   auto& grain = vtu.add_int_array("grain");
-  // The point's current domain x + e1 s1 + e2 s2, s in [-1, 1]^2: e1, e2 the columns of F D (the
-  // CPDI domain, also for linear shapes; the one analysis::domain_coverage rasterises).
-  auto& e1 = vtu.add_array("domain_e1", 3);
-  auto& e2 = vtu.add_array("domain_e2", 3);
+  // The point's current domain x + e1 s1 + e2 s2 (+ e3 s3 in 3D), s in [-1, 1]^Dim: e1, e2, e3
+  // the columns of F D (the CPDI domain, also for linear shapes; the one
+  // analysis::domain_coverage rasterises in 2D).
+  std::vector<std::vector<double>*> edges;
+  for (int k = 0; k < Dim; ++k)
+    edges.push_back(&vtu.add_array(fmt::format("domain_e{}", k + 1), 3));
   for (std::size_t i = 0; i < p.size(); ++i) {
-    vtu.set_position(i, p.x[i][0], p.x[i][1]);
-    vel[3 * i] = p.v[i][0];
-    vel[3 * i + 1] = p.v[i][1];
-    const Mat<2>& s = p.sigma[i];
-    const double s3[9] = {s(0, 0), s(0, 1), 0, s(1, 0), s(1, 1), 0, 0, 0, p.sigma_zz[i]};
-    for (int k = 0; k < 9; ++k) sig[9 * i + k] = s3[k];
-    pres[i] = -(s(0, 0) + s(1, 1) + p.sigma_zz[i]) / 3.0;  // p = -tr(sigma)/3 (plane strain)
+    const Mat<Dim>& s = p.sigma[i];
+    if constexpr (Dim == 2) {
+      vtu.set_position(i, p.x[i][0], p.x[i][1]);
+      const double s3[9] = {s(0, 0), s(0, 1), 0, s(1, 0), s(1, 1), 0, 0, 0, p.sigma_zz[i]};
+      for (int k = 0; k < 9; ++k) sig[9 * i + k] = s3[k];
+      pres[i] = -(s(0, 0) + s(1, 1) + p.sigma_zz[i]) / 3.0;  // p = -tr(sigma)/3 (plane strain)
+    } else {
+      vtu.set_position(i, p.x[i][0], p.x[i][1], p.x[i][2]);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) sig[9 * i + 3 * a + b] = s(a, b);
+      pres[i] = -s.trace() / 3.0;  // p = -tr(sigma)/3
+    }
+    for (int a = 0; a < Dim; ++a) vel[3 * i + a] = p.v[i][a];
     jac[i] = p.F[i].determinant();
     mass[i] = p.mass[i];
     vol[i] = p.volume[i];
     grain[i] = p.grain[i];
-    const Mat<2> e = p.F[i] * p.domain[i];
-    for (int k = 0; k < 2; ++k) {
-      e1[3 * i + k] = e(k, 0);
-      e2[3 * i + k] = e(k, 1);
-    }
+    const Mat<Dim> e = p.F[i] * p.domain[i];
+    for (int c = 0; c < Dim; ++c)
+      for (int k = 0; k < Dim; ++k) (*edges[c])[3 * i + k] = e(k, c);
   }
   vtu.write(path);
 }
@@ -68,7 +75,8 @@ std::int64_t trim_csv(const std::string& path, std::int64_t rows) {
   return std::max<std::int64_t>(kept, 0);
 }
 
-void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& pb,
+template <int Dim>
+void write_contacts(const mpm::Model<Dim>& model, const contact::Problem<Dim>& pb,
                     const std::string& vtu_path, const std::string& csv_path) {
   io::VtuPointCloud vtu(pb.contacts.size());
   auto& normal = vtu.add_array("normal", 3);
@@ -78,38 +86,49 @@ void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& pb,
   auto& gap = vtu.add_array("gap", 1);
   auto& body_a = vtu.add_int_array("body_a");
   auto& body_b = vtu.add_int_array("body_b");
-  std::map<std::pair<int, int>, Vec<2>> pairs;
+  std::map<std::pair<int, int>, Vec<Dim>> pairs;
   const double inv_dt = pb.dt > 0 ? 1.0 / pb.dt : 0.0;
   for (std::size_t i = 0; i < pb.contacts.size(); ++i) {
     const auto& c = pb.contacts[i];
     const auto& sb = pb.slots[c.b];
-    const Vec<2> x = model.grid.node_position(model.grid.node_coords(sb.node));
-    vtu.set_position(i, x[0], x[1]);
-    normal[3 * i] = c.normal[0];
-    normal[3 * i + 1] = c.normal[1];
+    const Vec<Dim> x = model.grid.node_position(model.grid.node_coords(sb.node));
+    vtu.set_position(i, x[0], x[1], Dim == 3 ? x[Dim - 1] : 0.0);
+    for (int a = 0; a < Dim; ++a) normal[3 * i + a] = c.normal[a];
     pn[i] = c.impulse.dot(c.normal);
-    pt[i] = c.impulse[1] * c.normal[0] - c.impulse[0] * c.normal[1];  // along t = e_z x n
+    if constexpr (Dim == 2)
+      pt[i] = c.impulse[1] * c.normal[0] - c.impulse[0] * c.normal[1];  // along t = e_z x n
+    else
+      pt[i] = (c.impulse - pn[i] * c.normal).norm();  // 3D: the tangential part's magnitude
     // The contact's force on body b [N/m], P/dt as contact::impulse_force but multiplied by 1/dt:
     // its quotient differs in the last bit, and these files stay as they were written before.
-    const Vec<2> f = c.impulse * inv_dt;
-    force[3 * i] = f[0];
-    force[3 * i + 1] = f[1];
+    const Vec<Dim> f = c.impulse * inv_dt;
+    for (int a = 0; a < Dim; ++a) force[3 * i + a] = f[a];
     gap[i] = c.gap;
     body_a[i] = c.a >= 0 ? pb.slots[c.a].grain : -1 - c.wall;
     body_b[i] = sb.grain;
     // try_emplace with an explicit zero: Eigen vectors are not zero-initialised.
-    pairs.try_emplace({body_a[i], body_b[i]}, Vec<2>::Zero()).first->second += f;
+    pairs.try_emplace({body_a[i], body_b[i]}, Vec<Dim>::Zero()).first->second += f;
   }
   vtu.write(vtu_path);
-  std::string text = "body_a,body_b,force_x,force_y\n";
-  for (const auto& [key, f] : pairs)
-    text += fmt::format("{},{},{:.12e},{:.12e}\n", key.first, key.second, f[0], f[1]);
+  std::string text =
+      Dim == 3 ? "body_a,body_b,force_x,force_y,force_z\n" : "body_a,body_b,force_x,force_y\n";
+  for (const auto& [key, f] : pairs) {
+    text += fmt::format("{},{},{:.12e},{:.12e}", key.first, key.second, f[0], f[1]);
+    text += Dim == 3 ? fmt::format(",{:.12e}\n", f[Dim - 1]) : "\n";
+  }
   io::write_file_atomic(csv_path, text);
 }
 
+template void write_points_vtu<2>(const mpm::Model<2>&, const std::string&);
+template void write_points_vtu<3>(const mpm::Model<3>&, const std::string&);
+template void write_contacts<2>(const mpm::Model<2>&, const contact::Problem<2>&,
+                                const std::string&, const std::string&);
+template void write_contacts<3>(const mpm::Model<3>&, const contact::Problem<3>&,
+                                const std::string&, const std::string&);
+
 Outputs::Outputs(const io::Config& cfg, const std::string& dir, const std::string& extra_header,
                  const checkpoint::State* restart, const std::string& history)
-    : cfg_(cfg), dir_(dir) {
+    : cfg_(cfg), dir_(dir), dim_(cfg.simulation.dimension) {
   fs::create_directories(dir_);
   if (restart && !history.empty()) copy_history(history, *restart);
   // Input copy, stamped with the version that ran it.
@@ -120,8 +139,13 @@ Outputs::Outputs(const io::Config& cfg, const std::string& dir, const std::strin
   csv_path_ = (fs::path(dir_) / (cfg.simulation.name + ".csv")).string();
   std::string header =
       "step,time,dt,newton_iterations,linear_solves,kinetic_energy,elastic_energy,"
-      "total_energy,momentum_x,momentum_y,mass,volume,contacts,active_contacts,gs_sweeps";
-  for (const auto& w : cfg.walls) header += ",wall_" + w.name + "_fx,wall_" + w.name + "_fy";
+      "total_energy,momentum_x,momentum_y";
+  if (dim_ == 3) header += ",momentum_z";
+  header += ",mass,volume,contacts,active_contacts,gs_sweeps";
+  for (const auto& w : cfg.walls) {
+    header += ",wall_" + w.name + "_fx,wall_" + w.name + "_fy";
+    if (dim_ == 3) header += ",wall_" + w.name + "_fz";
+  }
   header += extra_header + "\n";
   if (restart && fs::exists(csv_path_)) {
     csv_rows_ = trim_csv(csv_path_, restart->csv_rows);
@@ -184,7 +208,8 @@ void Outputs::copy_history(const std::string& from, const checkpoint::State& res
              from);
 }
 
-void Outputs::restore_contacts(const mpm::ImplicitSolver<2>& solver) {
+template <int Dim>
+void Outputs::restore_contacts(const mpm::ImplicitSolver<Dim>& solver) {
   if (!pvd_ || !solver.settings().contact.enabled) return;
   contacts_pvd_ = std::make_unique<io::PvdSeries>(
       (fs::path(dir_) / (cfg_.simulation.name + "_contacts.pvd")).string());
@@ -194,33 +219,40 @@ void Outputs::restore_contacts(const mpm::ImplicitSolver<2>& solver) {
   }
 }
 
+template <int Dim>
 void Outputs::csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& st,
-                      const mpm::Diagnostics<2>& d, const std::string& extra) {
-  std::string row =
-      fmt::format("{},{:.12e},{:.6e},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}",
-                  step, t, dt, st.iterations, st.linear_solves, d.kinetic, d.elastic,
-                  d.kinetic + d.elastic, d.momentum[0], d.momentum[1], d.mass, d.volume);
+                      const mpm::Diagnostics<Dim>& d, const std::string& extra) {
+  std::string row = fmt::format("{},{:.12e},{:.6e},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}",
+                                step, t, dt, st.iterations, st.linear_solves, d.kinetic, d.elastic,
+                                d.kinetic + d.elastic, d.momentum[0], d.momentum[1]);
+  if constexpr (Dim == 3) row += fmt::format(",{:.12e}", d.momentum[2]);
+  row += fmt::format(",{:.12e},{:.12e}", d.mass, d.volume);
   row += fmt::format(",{},{},{}", st.contacts, st.active_contacts, st.gs_sweeps);
   for (std::size_t k = 0; k < cfg_.walls.size(); ++k) {
     const bool have = k < st.wall_force.size();
     row += fmt::format(",{:.12e},{:.12e}", have ? st.wall_force[k][0] : 0.0,
                        have ? st.wall_force[k][1] : 0.0);
+    if constexpr (Dim == 3) row += fmt::format(",{:.12e}", have ? st.wall_force[k][2] : 0.0);
   }
   row += extra + "\n";
   write_row(row);
   ++csv_rows_;
 }
 
-void Outputs::vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
-                  const contact::Problem<2>& problem, double t) {
-  if (cfg_.output.grains) {  // grain-scale files at every snapshot time, with or without VTU
-    const GrainSnapshot snap = grain_snapshot(model, problem);
-    const std::string gname = fmt::format("{}_grains_{:06d}.csv", cfg_.simulation.name, vtu_count_);
-    write_grains_csv(model, snap, t, (fs::path(dir_) / gname).string());
-    if (solver.settings().contact.enabled) {
-      const std::string fname =
-          fmt::format("{}_forces_{:06d}.csv", cfg_.simulation.name, vtu_count_);
-      write_contact_forces_csv(snap, t, (fs::path(dir_) / fname).string());
+template <int Dim>
+void Outputs::vtu(const mpm::Model<Dim>& model, const mpm::ImplicitSolver<Dim>& solver,
+                  const contact::Problem<Dim>& problem, double t) {
+  if constexpr (Dim == 2) {    // 3D inputs refuse [output] grains
+    if (cfg_.output.grains) {  // grain-scale files at every snapshot time, with or without VTU
+      const GrainSnapshot snap = grain_snapshot(model, problem);
+      const std::string gname =
+          fmt::format("{}_grains_{:06d}.csv", cfg_.simulation.name, vtu_count_);
+      write_grains_csv(model, snap, t, (fs::path(dir_) / gname).string());
+      if (solver.settings().contact.enabled) {
+        const std::string fname =
+            fmt::format("{}_forces_{:06d}.csv", cfg_.simulation.name, vtu_count_);
+        write_contact_forces_csv(snap, t, (fs::path(dir_) / fname).string());
+      }
     }
   }
   if (!pvd_) {
@@ -248,11 +280,23 @@ void Outputs::vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solv
   ++vtu_count_;
 }
 
-std::string Outputs::last_good(const mpm::Model<2>& model) {
+template <int Dim>
+std::string Outputs::last_good(const mpm::Model<Dim>& model) {
   const std::string path = (fs::path(dir_) / (cfg_.simulation.name + "_last_good.vtu")).string();
   write_points_vtu(model, path);
   return path;
 }
+
+#define MPMCD_OUTPUTS(Dim)                                                                 \
+  template void Outputs::restore_contacts<Dim>(const mpm::ImplicitSolver<Dim>&);           \
+  template void Outputs::csv_row<Dim>(std::int64_t, double, double, const mpm::StepStats&, \
+                                      const mpm::Diagnostics<Dim>&, const std::string&);   \
+  template void Outputs::vtu<Dim>(const mpm::Model<Dim>&, const mpm::ImplicitSolver<Dim>&, \
+                                  const contact::Problem<Dim>&, double);                   \
+  template std::string Outputs::last_good<Dim>(const mpm::Model<Dim>&);
+MPMCD_OUTPUTS(2)
+MPMCD_OUTPUTS(3)
+#undef MPMCD_OUTPUTS
 
 void Outputs::write_row(const std::string& row) {
   csv_.write(row.data(), static_cast<std::streamsize>(row.size()));

@@ -39,9 +39,10 @@ class SignalGuard {
   struct sigaction old_int_ = {}, old_term_ = {};
 };
 
-/// One run: its model and solver, its outputs and its counters. Processes (docs/parallel.md):
-/// every rank holds the model and computes its grains; rank 0 gathers the state at output and
-/// checkpoint times and writes every file.
+/// One run in Dim = 2 or 3 dimensions: its model and solver, its outputs and its counters.
+/// Processes (docs/parallel.md): every rank holds the model and computes its grains; rank 0
+/// gathers the state at output and checkpoint times and writes every file.
+template <int Dim>
 class Run {
  public:
   /// Builds or restores everything (may throw InputError: before any output is written), then
@@ -66,25 +67,25 @@ class Run {
   checkpoint::State state_now(const std::string& reason);
   std::string write_checkpoint(const std::string& reason);
   [[noreturn]] void fail(const mpm::StepStats& st);
-  std::pair<ProgressSample, std::optional<CompactionObserver::Now>> progress_sample(
+  std::pair<ProgressSample, std::optional<typename CompactionObserver<Dim>::Now>> progress_sample(
       const mpm::StepStats& st, double wall);
   void report_progress(const mpm::StepStats& st, double wall);
 
   const io::Config& cfg_;
   const RunOptions& opt_;
   const checkpoint::State* restart_;  // the checkpoint continued (nullptr: a new run)
-  mpm::Model<2> model_;
-  const mpm::Settings<2> settings_;
-  CompactionObserver observer_;  // follows the walls moved by loading_
+  mpm::Model<Dim> model_;
+  const mpm::Settings<Dim> settings_;
+  CompactionObserver<Dim> observer_;  // follows the walls moved by loading_
   const parallel::Comm& comm_;
   const bool root_;
   const parallel::Scheme scheme_;
   const bool any_moving_, stop_active_;
   RunSummary summary_;
   std::optional<SignalGuard> signals_;
-  std::unique_ptr<mpm::ImplicitSolver<2>> solver_;
-  EnergyLedger<2> ledger_;
-  WallLoading loading_;           // [loading]: the walls' motion in stages (inactive without it)
+  std::unique_ptr<mpm::ImplicitSolver<Dim>> solver_;
+  EnergyLedger<Dim> ledger_;
+  WallLoading<Dim> loading_;      // [loading]: the walls' motion in stages (inactive without it)
   std::unique_ptr<Outputs> out_;  // rank 0 only
   StepController dt_control_;
   ProgressEstimator progress_;

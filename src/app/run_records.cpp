@@ -17,13 +17,15 @@ namespace mpmcd::app::detail {
 namespace fs = std::filesystem;
 
 // Rank 0 gathers every grain's points (collective).
-void Run::gather_state() {
+template <int Dim>
+void Run<Dim>::gather_state() {
   ScopedStage ts(&solver_->timers(), "output");
   parallel::gather_points(comm_, model_.points, model_.grains, solver_->owner(), 0);
 }
 
 // The CSV row and the VTU snapshot of the committed state, when due or `force`d (collective).
-void Run::record(bool force) {
+template <int Dim>
+void Run<Dim>::record(bool force) {
   const double eps = 1e-9 * cfg_.time.dt;
   const bool csv = force || t_ >= next_csv_ - eps, vtu = force || t_ >= next_vtu_ - eps;
   if (!csv && !vtu) return;
@@ -60,7 +62,8 @@ void Run::record(bool force) {
 
 // The run's counters, as its checkpoint written for `reason` holds them (on rank 0; the model,
 // the warm start and the work counts are added by write_checkpoint).
-checkpoint::State Run::state_now(const std::string& reason) {
+template <int Dim>
+checkpoint::State Run<Dim>::state_now(const std::string& reason) {
   checkpoint::State s;
   s.reason = reason;
   s.step = summary_.steps;
@@ -85,7 +88,8 @@ checkpoint::State Run::state_now(const std::string& reason) {
 
 // Writes the checkpoint of the committed state (collective: rank 0 gathers every grain and
 // every rank's warm-start impulses and writes one file); returns its path on rank 0.
-std::string Run::write_checkpoint(const std::string& reason) {
+template <int Dim>
+std::string Run<Dim>::write_checkpoint(const std::string& reason) {
   ScopedStage ts(&solver_->timers(), "checkpoint");
   if (comm_.size() > 1) gather_state();
   // Warm-start impulses of every rank (each contact is solved by one rank).
@@ -111,7 +115,8 @@ std::string Run::write_checkpoint(const std::string& reason) {
 
 // The step after summary_.steps failed for good (not retryable, or dt at dt_min): writes the last
 // good state and its checkpoint, and throws NumericalError.
-void Run::fail(const mpm::StepStats& st) {
+template <int Dim>
+void Run<Dim>::fail(const mpm::StepStats& st) {
   const std::int64_t good = summary_.steps;
   if (comm_.size() > 1) gather_state();
   const std::string saved = root_ ? out_->last_good(model_) : std::string();
@@ -137,14 +142,15 @@ void Run::fail(const mpm::StepStats& st) {
 
 // Progress toward the criterion that will end the run (docs/robustness.md, "Progress"): the
 // compaction state of the committed step (collective: the grains' area is summed over ranks).
-std::pair<ProgressSample, std::optional<CompactionObserver::Now>> Run::progress_sample(
-    const mpm::StepStats& st, double wall) {
+template <int Dim>
+std::pair<ProgressSample, std::optional<typename CompactionObserver<Dim>::Now>>
+Run<Dim>::progress_sample(const mpm::StepStats& st, double wall) {
   ProgressSample s{wall, t_, std::nullopt, std::nullopt, std::nullopt};
   if (!observer_.has_box()) return {s, std::nullopt};
-  std::vector<double> areas = CompactionObserver::grain_areas(
+  std::vector<double> areas = CompactionObserver<Dim>::grain_areas(
       model_, comm_.size() > 1 ? &solver_->owner() : nullptr, comm_.rank());
   if (comm_.size() > 1) comm_.sum(areas);
-  const auto now = observer_.now(CompactionObserver::total_area(areas), st, t_);
+  const auto now = observer_.now(CompactionObserver<Dim>::total_area(areas), st, t_);
   s.phi = now->phi;
   s.strain = now->strain;
   if (!st.wall_force.empty()) s.stress = -now->bottom_stress;  // none before the first step
@@ -152,7 +158,8 @@ std::pair<ProgressSample, std::optional<CompactionObserver::Now>> Run::progress_
 }
 
 // The progress line after the committed step `st`, `wall` [s] after this invocation started.
-void Run::report_progress(const mpm::StepStats& st, double wall) {
+template <int Dim>
+void Run<Dim>::report_progress(const mpm::StepStats& st, double wall) {
   const auto [sample, state] = progress_sample(st, wall);
   progress_.add(sample);
   std::optional<double> z;
@@ -172,4 +179,18 @@ void Run::report_progress(const mpm::StepStats& st, double wall) {
                                      : "",
       observed, st.iterations, rate, format_eta(e.eta));
 }
+// The members defined in this file, for both dimensions (simulation.cpp instantiates the rest).
+#define MPMCD_RUN_RECORDS(Dim)                                                             \
+  template void Run<Dim>::gather_state();                                                  \
+  template void Run<Dim>::record(bool);                                                    \
+  template checkpoint::State Run<Dim>::state_now(const std::string&);                      \
+  template std::string Run<Dim>::write_checkpoint(const std::string&);                     \
+  template void Run<Dim>::fail(const mpm::StepStats&);                                     \
+  template std::pair<ProgressSample, std::optional<typename CompactionObserver<Dim>::Now>> \
+  Run<Dim>::progress_sample(const mpm::StepStats&, double);                                \
+  template void Run<Dim>::report_progress(const mpm::StepStats&, double);
+MPMCD_RUN_RECORDS(2)
+MPMCD_RUN_RECORDS(3)
+#undef MPMCD_RUN_RECORDS
+
 }  // namespace mpmcd::app::detail

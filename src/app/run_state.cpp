@@ -150,38 +150,47 @@ std::vector<mpm::WarmImpulse<Dim>> warm_start_of(const checkpoint::State& s) {
 
 namespace {
 constexpr std::size_t kLoadingStageValues = 5;  // checkpoint::State::loading_stage
-// checkpoint::State::loading_wall, per wall: 13 since the servo's integral, 12 before (read as
-// an integral of 0).
-constexpr std::size_t kLoadingWallValues = 13, kLoadingWallValuesBefore = 12;
+// checkpoint::State::loading_wall, per wall: 4 Dim + 5 since the servo's integral (13 in 2D),
+// 4 Dim + 4 before (12, read as an integral of 0).
+template <int Dim>
+constexpr std::size_t kLoadingWallValues = 4 * Dim + 5;
+template <int Dim>
+constexpr std::size_t kLoadingWallValuesBefore = 4 * Dim + 4;
 }  // namespace
 
-void store_loading(const LoadingState& l, checkpoint::State& s) {
+template <int Dim>
+void store_loading(const LoadingState<Dim>& l, checkpoint::State& s) {
   s.loading_stage = {static_cast<double>(l.stage), l.stage_start, l.phi0, l.eps0, l.stress0};
   s.loading_control.clear();
   s.loading_wall.clear();
+  const auto put_vec = [&](const Vec<Dim>& v) {
+    for (int a = 0; a < Dim; ++a) s.loading_wall.push_back(v[a]);
+  };
   for (std::size_t k = 0; k < l.programs.size(); ++k) {
-    const WallProgram& p = l.programs[k];
+    const WallProgram<Dim>& p = l.programs[k];
     s.loading_control.push_back(static_cast<std::int32_t>(p.control));
-    for (const double x :
-         {p.v_from[0], p.v_from[1], p.v_to[0], p.v_to[1], p.s_from, p.s_to, p.t_start, p.ramp,
-          l.velocity[k][0], l.velocity[k][1], l.force[k][0], l.force[k][1], l.integral[k]})
-      s.loading_wall.push_back(x);
+    put_vec(p.v_from);
+    put_vec(p.v_to);
+    for (const double x : {p.s_from, p.s_to, p.t_start, p.ramp}) s.loading_wall.push_back(x);
+    put_vec(l.velocity[k]);
+    put_vec(l.force[k]);
+    s.loading_wall.push_back(l.integral[k]);
   }
 }
 
-LoadingState loading_state_of(const checkpoint::State& s) {
+template <int Dim>
+LoadingState<Dim> loading_state_of(const checkpoint::State& s) {
+  constexpr std::size_t kAll = kLoadingWallValues<Dim>, kBefore = kLoadingWallValuesBefore<Dim>;
   const std::size_t nw = s.loading_control.size();
   if (s.loading_stage.size() != kLoadingStageValues)
     throw std::invalid_argument(
         "the input has [loading], the checkpoint no loading state (written without it)");
-  const std::size_t per_wall = nw > 0 && s.loading_wall.size() == nw * kLoadingWallValuesBefore
-                                   ? kLoadingWallValuesBefore
-                                   : kLoadingWallValues;
-  if (s.loading_wall.size() != nw * per_wall || s.wall_point.size() != 2 * nw)
+  const std::size_t per_wall = nw > 0 && s.loading_wall.size() == nw * kBefore ? kBefore : kAll;
+  if (s.loading_wall.size() != nw * per_wall || s.wall_point.size() != Dim * nw)
     throw std::invalid_argument(fmt::format(
         "the checkpoint's loading state has {} values for {} walls, expected {} per wall",
-        s.loading_wall.size(), nw, kLoadingWallValues));
-  LoadingState l;
+        s.loading_wall.size(), nw, kAll));
+  LoadingState<Dim> l;
   l.stage = static_cast<std::int32_t>(s.loading_stage[0]);
   l.stage_start = s.loading_stage[1];
   l.phi0 = s.loading_stage[2];
@@ -191,22 +200,32 @@ LoadingState loading_state_of(const checkpoint::State& s) {
     const double* x = &s.loading_wall[k * per_wall];
     if (s.loading_control[k] != 0 && s.loading_control[k] != 1)
       throw std::invalid_argument(fmt::format("wall {} has control {}", k, s.loading_control[k]));
-    WallProgram p;
+    WallProgram<Dim> p;
+    const auto vec = [&](std::size_t at) {  // the Dim values from x[at]
+      Vec<Dim> v;
+      for (int a = 0; a < Dim; ++a) v[a] = x[at + static_cast<std::size_t>(a)];
+      return v;
+    };
     p.control = static_cast<WallControl>(s.loading_control[k]);
-    p.v_from = Vec<2>(x[0], x[1]);
-    p.v_to = Vec<2>(x[2], x[3]);
-    p.s_from = x[4];
-    p.s_to = x[5];
-    p.t_start = x[6];
-    p.ramp = x[7];
+    p.v_from = vec(0);
+    p.v_to = vec(Dim);
+    p.s_from = x[2 * Dim];
+    p.s_to = x[2 * Dim + 1];
+    p.t_start = x[2 * Dim + 2];
+    p.ramp = x[2 * Dim + 3];
     l.programs.push_back(p);
-    l.velocity.emplace_back(x[8], x[9]);
-    l.force.emplace_back(x[10], x[11]);
-    l.integral.push_back(per_wall > kLoadingWallValuesBefore ? x[12] : 0.0);
-    l.position.emplace_back(s.wall_point[2 * k], s.wall_point[2 * k + 1]);
+    l.velocity.push_back(vec(2 * Dim + 4));
+    l.force.push_back(vec(3 * Dim + 4));
+    l.integral.push_back(per_wall > kBefore ? x[4 * Dim + 4] : 0.0);
+    l.position.push_back(vec_at<Dim>(s.wall_point, k));
   }
   return l;
 }
+
+template void store_loading<2>(const LoadingState<2>&, checkpoint::State&);
+template void store_loading<3>(const LoadingState<3>&, checkpoint::State&);
+template LoadingState<2> loading_state_of<2>(const checkpoint::State&);
+template LoadingState<3> loading_state_of<3>(const checkpoint::State&);
 
 void store_energy(const EnergySums& e, checkpoint::State& s) {
   for_each_energy_field([&](auto sum, auto field) { s.*field = e.*sum; });
@@ -263,9 +282,15 @@ mpm::Model<Dim> restore_model(const io::Config& cfg, const checkpoint::State& s,
 template void store_run<2>(const io::Config&, const mpm::Model<2>&,
                            const std::vector<mpm::WarmImpulse<2>>&,
                            const std::vector<walls::Wall<2>>&, checkpoint::State&);
+template void store_run<3>(const io::Config&, const mpm::Model<3>&,
+                           const std::vector<mpm::WarmImpulse<3>>&,
+                           const std::vector<walls::Wall<3>>&, checkpoint::State&);
 template mpm::Model<2> restore_model<2>(const io::Config&, const checkpoint::State&,
                                         const std::string&);
+template mpm::Model<3> restore_model<3>(const io::Config&, const checkpoint::State&,
+                                        const std::string&);
 template std::vector<mpm::WarmImpulse<2>> warm_start_of<2>(const checkpoint::State&);
+template std::vector<mpm::WarmImpulse<3>> warm_start_of<3>(const checkpoint::State&);
 
 Restart load_restart(const std::string& path, const std::string& input) {
   Restart r;

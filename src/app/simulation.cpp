@@ -48,15 +48,18 @@ const char* signal_name(int sig) {
 
 // The model of the run, after the thread count is set (a packing input runs its DEM on the
 // threads): restored from the checkpoint `restart`, or built from the input.
-mpm::Model<2> initial_model(const io::Config& cfg, const RunOptions& opt,
-                            const checkpoint::State* restart) {
+template <int Dim>
+mpm::Model<Dim> initial_model(const io::Config& cfg, const RunOptions& opt,
+                              const checkpoint::State* restart) {
   const int threads = opt.threads > 0 ? opt.threads : cfg.simulation.threads;
   if (threads > 0) omp_set_num_threads(threads);
-  return restart ? restore_model<2>(cfg, *restart, opt.restart) : build_model(cfg);
+  return restart ? restore_model<Dim>(cfg, *restart, opt.restart) : build_model<Dim>(cfg);
 }
 
 // The solver settings; a new run's walls must enclose its grains.
-mpm::Settings<2> checked_settings(const io::Config& cfg, const mpm::Model<2>& model, bool restart) {
+template <int Dim>
+mpm::Settings<Dim> checked_settings(const io::Config& cfg, const mpm::Model<Dim>& model,
+                                    bool restart) {
   auto settings = build_settings(cfg, model);
   if (!restart) check_walls_enclose(cfg, model, settings);
   return settings;
@@ -64,10 +67,11 @@ mpm::Settings<2> checked_settings(const io::Config& cfg, const mpm::Model<2>& mo
 
 // The energy ledger's sums where the run starts: the checkpoint's, or zero sums from the model's
 // energy at t = 0 (every rank holds the initial points).
-EnergySums start_energy(const io::Config& cfg, const mpm::Model<2>& model,
+template <int Dim>
+EnergySums start_energy(const io::Config& cfg, const mpm::Model<Dim>& model,
                         const checkpoint::State* restart) {
   return restart ? energy_sums_of(*restart)
-                 : EnergyLedger<2>::start(cfg.walls.size(), mpm::diagnostics(model));
+                 : EnergyLedger<Dim>::start(cfg.walls.size(), mpm::diagnostics(model));
 }
 
 }  // namespace
@@ -89,11 +93,12 @@ SignalGuard::~SignalGuard() {
   sigaction(SIGTERM, &old_term_, nullptr);
 }
 
-Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* restart)
+template <int Dim>
+Run<Dim>::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* restart)
     : cfg_(cfg),
       opt_(opt),
       restart_(restart),
-      model_(initial_model(cfg, opt, restart)),
+      model_(initial_model<Dim>(cfg, opt, restart)),
       settings_(checked_settings(cfg, model_, restart != nullptr)),
       observer_(cfg, model_),
       comm_(parallel::Comm::world()),
@@ -117,32 +122,34 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
   const std::string history_dir =
       prepare_output_folder(cfg, opt, summary_.output_dir, restart != nullptr, comm_);
   signals_.emplace();
-  solver_ = std::make_unique<mpm::ImplicitSolver<2>>(model_.grid, settings_, model_.points,
-                                                     model_.grains, model_.law_ptrs());
+  solver_ = std::make_unique<mpm::ImplicitSolver<Dim>>(model_.grid, settings_, model_.points,
+                                                       model_.grains, model_.law_ptrs());
   solver_->set_boundary_conditions(build_boundaries(cfg, model_.grid, 0.0));
   distribute();
   if (root_)  // after every input check: nothing written before
     out_ = std::make_unique<Outputs>(
         cfg, summary_.output_dir,
-        observer_.csv_header() + loading_.csv_header() + EnergyLedger<2>::csv_header(cfg), restart,
-        history_dir);
+        observer_.csv_header() + loading_.csv_header() + EnergyLedger<Dim>::csv_header(cfg),
+        restart, history_dir);
+  std::string cells = fmt::format("{}", model_.grid.cells()[0]);
+  for (int a = 1; a < Dim; ++a) cells += fmt::format("x{}", model_.grid.cells()[a]);
   log().info(
-      "mpmcd {} ({}): {} grains, {} material points, grid {}x{} cells of {} m, {} rank(s) x {} "
+      "mpmcd {} ({}): {}{} grains, {} material points, grid {} cells of {} m, {} rank(s) x {} "
       "threads ({})",
-      kVersion, kGitHash, model_.grains.size(), model_.points.size(), model_.grid.cells()[0],
-      model_.grid.cells()[1], model_.grid.cell_size(), comm_.size(), omp_get_max_threads(),
-      openmp_wait_policy());
+      kVersion, kGitHash, Dim == 3 ? "3D, " : "", model_.grains.size(), model_.points.size(), cells,
+      model_.grid.cell_size(), comm_.size(), omp_get_max_threads(), openmp_wait_policy());
   if (loading_.active()) {
     if (restart) {
       try {
-        loading_.restore(loading_state_of(*restart));
+        loading_.restore(loading_state_of<Dim>(*restart));
       } catch (const std::invalid_argument& e) {
         throw InputError(opt.restart, 0, "",
                          fmt::format("checkpoint does not fit its input: {}", e.what()));
       }
       observer_.move_walls(loading_.walls(t_));
     } else {
-      loading_.start(CompactionObserver::total_area(CompactionObserver::grain_areas(model_)));
+      loading_.start(
+          CompactionObserver<Dim>::total_area(CompactionObserver<Dim>::grain_areas(model_)));
     }
     log().info("{}", loading_.describe());
   }
@@ -152,7 +159,7 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
     summary_.failed_steps = restart->failed_steps;
     summary_.newton_iterations = restart->newton_iterations;
     // Every rank gets every impulse; a rank looks up only the contacts it solves.
-    solver_->set_warm_start(warm_start_of<2>(*restart));
+    solver_->set_warm_start(warm_start_of<Dim>(*restart));
     if (root_) out_->restore_contacts(*solver_);
     log().info("restarted from {} (written by mpmcd {} on {} rank(s)): step {}, t = {:.9g} s",
                opt.restart, restart->mpmcd_version, restart->ranks, summary_.steps, t_);
@@ -172,7 +179,8 @@ Run::Run(const io::Config& cfg, const RunOptions& opt, const checkpoint::State* 
 // Deals the grains to the ranks. A restart on the same ranks and scheme keeps the checkpoint's
 // distribution and re-balancing counts (bitwise continuation); otherwise the grains are dealt
 // again from the restored state.
-void Run::distribute() {
+template <int Dim>
+void Run<Dim>::distribute() {
   const bool keep = restart_ && restart_->ranks == comm_.size() &&
                     restart_->scheme == parallel::to_string(scheme_);
   if (comm_.size() > 1) {
@@ -192,7 +200,8 @@ void Run::distribute() {
 }
 
 // Commits the converged step of length dt [s]: points, energy ledger, re-balancing, counters.
-void Run::commit(const mpm::StepStats& st, double dt) {
+template <int Dim>
+void Run<Dim>::commit(const mpm::StepStats& st, double dt) {
   solver_->commit();
   last_ = st;
   ledger_.add_step(st, solver_->settings().contact.walls, dt);  // the walls of this step
@@ -207,7 +216,8 @@ void Run::commit(const mpm::StepStats& st, double dt) {
 }
 
 // Deals the grains again when the work imbalance exceeds --rebalance (collective).
-void Run::rebalance() {
+template <int Dim>
+void Run<Dim>::rebalance() {
   ScopedStage ts(&solver_->timers(), "rebalance");
   auto owner = solver_->owner();
   bool moved = false;
@@ -223,29 +233,32 @@ void Run::rebalance() {
 // The [stop] criterion reached by the committed step, if any. Phi needs every grain's area: on
 // several ranks each one's grains, summed per grain over the ranks (exact: the other ranks add
 // zeros), then over the grains in order, as one process does.
-std::optional<std::string> Run::stop_criterion(const mpm::StepStats& st) {
+template <int Dim>
+std::optional<std::string> Run<Dim>::stop_criterion(const mpm::StepStats& st) {
   if (!stop_active_) return std::nullopt;
   if (comm_.size() == 1) return observer_.stop_reason(model_, st, t_);
   ScopedStage ts(&solver_->timers(), "output");
-  auto areas = CompactionObserver::grain_areas(model_, &solver_->owner(), comm_.rank());
+  auto areas = CompactionObserver<Dim>::grain_areas(model_, &solver_->owner(), comm_.rank());
   comm_.sum(areas);
-  return observer_.stop_reason(CompactionObserver::total_area(areas), st, t_);
+  return observer_.stop_reason(CompactionObserver<Dim>::total_area(areas), st, t_);
 }
 
 // V_s, the grains' current area [m^2] (collective on several ranks: summed per grain over the
 // ranks, then over the grains in order, as stop_criterion does).
-double Run::grain_area() {
+template <int Dim>
+double Run<Dim>::grain_area() {
   if (comm_.size() == 1)
-    return CompactionObserver::total_area(CompactionObserver::grain_areas(model_));
-  auto areas = CompactionObserver::grain_areas(model_, &solver_->owner(), comm_.rank());
+    return CompactionObserver<Dim>::total_area(CompactionObserver<Dim>::grain_areas(model_));
+  auto areas = CompactionObserver<Dim>::grain_areas(model_, &solver_->owner(), comm_.rank());
   comm_.sum(areas);
-  return CompactionObserver::total_area(areas);
+  return CompactionObserver<Dim>::total_area(areas);
 }
 
 // The loading after the committed step of length dt [s] (every rank: the wall forces are
 // reduced over the ranks, Phi when a stage needs it is collective): walls moved, stage ended.
 // Returns the reason to end the run once the last stage has ended.
-std::optional<std::string> Run::loading_step(const mpm::StepStats& st, double dt) {
+template <int Dim>
+std::optional<std::string> Run<Dim>::loading_step(const mpm::StepStats& st, double dt) {
   if (!loading_.active()) return std::nullopt;
   loading_.committed(st, dt);
   observer_.move_walls(loading_.walls(t_));
@@ -261,7 +274,8 @@ std::optional<std::string> Run::loading_step(const mpm::StepStats& st, double dt
 // After a committed step that did not end the run (`at_end`: it reached end_time): a signal or
 // --stop-after writes a checkpoint and returns false (stop); periodic checkpoints; the progress
 // line. Collective.
-bool Run::between_steps(const mpm::StepStats& st, bool at_end) {
+template <int Dim>
+bool Run<Dim>::between_steps(const mpm::StepStats& st, bool at_end) {
   const auto now = std::chrono::steady_clock::now();
   const bool stop = opt_.stop_after > 0 && summary_.steps - steps0_ >= opt_.stop_after;
   const bool due_steps =
@@ -296,7 +310,8 @@ bool Run::between_steps(const mpm::StepStats& st, bool at_end) {
   return true;
 }
 
-RunSummary Run::go() {
+template <int Dim>
+RunSummary Run<Dim>::go() {
   if (!restart_) record(true);
   comm_.record_syncs();  // the serial fraction, measured at every synchronisation
   wall0_ = last_progress_ = last_checkpoint_wall_ = std::chrono::steady_clock::now();
@@ -336,7 +351,8 @@ RunSummary Run::go() {
 }
 
 // The end of the run: its checkpoint, the timers (<name>_timers.csv), the energy balance.
-RunSummary Run::finish() {
+template <int Dim>
+RunSummary Run<Dim>::finish() {
   if (!summary_.interrupted && cfg_.checkpoint.at_end && last_checkpoint_step_ != summary_.steps)
     write_checkpoint("end");
   summary_.time = t_;
@@ -376,11 +392,15 @@ RunSummary Run::finish() {
   return summary_;
 }
 
+template class Run<2>;
+template class Run<3>;
+
 }  // namespace detail
 
 RunSummary run_simulation(const io::Config& cfg, const RunOptions& opt,
                           const checkpoint::State* restart) {
-  return detail::Run(cfg, opt, restart).go();
+  if (cfg.simulation.dimension == 3) return detail::Run<3>(cfg, opt, restart).go();
+  return detail::Run<2>(cfg, opt, restart).go();
 }
 
 }  // namespace mpmcd::app

@@ -15,14 +15,17 @@ std::string material_name(const io::Config& config, std::size_t k) {
 
 }  // namespace
 
-std::vector<double> wave_speeds(const mpm::Model<2>& model) {
+template <int Dim>
+std::vector<double> wave_speeds(const mpm::Model<Dim>& model) {
   std::vector<double> c(model.laws.size(), 0.0);
   for (std::size_t k = 0; k < c.size(); ++k)
     c[k] = std::sqrt(model.laws[k]->wave_modulus() / model.densities[k]);
   return c;
 }
 
-std::optional<std::string> fast_wall_warning(const io::Config& config, const mpm::Model<2>& model) {
+template <int Dim>
+std::optional<std::string> fast_wall_warning(const io::Config& config,
+                                             const mpm::Model<Dim>& model) {
   const auto c = wave_speeds(model);
   // The slowest material any grain is made of.
   double c_min = std::numeric_limits<double>::infinity();
@@ -36,7 +39,9 @@ std::optional<std::string> fast_wall_warning(const io::Config& config, const mpm
   std::string walls;
   int fast = 0;
   for (const auto& w : config.walls) {
-    const double speed = std::hypot(w.velocity.at(0), w.velocity.at(1));
+    const double speed =
+        Dim == 2 ? std::hypot(w.velocity.at(0), w.velocity.at(1))
+                 : std::hypot(w.velocity.at(0), w.velocity.at(1), w.velocity.at(Dim - 1));
     if (!(speed > kFastWallFraction * c_min)) continue;
     if (++fast <= 3)
       walls += fmt::format("{}'{}' at {:.3g} m/s ({:.3g} c)", fast > 1 ? ", " : "", w.name, speed,
@@ -52,8 +57,9 @@ std::optional<std::string> fast_wall_warning(const io::Config& config, const mpm
       material_name(config, slowest));
 }
 
-std::optional<std::string> fast_point_warning(const io::Config& config, const mpm::Model<2>& model,
-                                              double t) {
+template <int Dim>
+std::optional<std::string> fast_point_warning(const io::Config& config,
+                                              const mpm::Model<Dim>& model, double t) {
   const auto c = wave_speeds(model);
   const auto& p = model.points;
   std::size_t fastest = 0, count = 0;
@@ -80,5 +86,15 @@ std::optional<std::string> fast_point_warning(const io::Config& config, const mp
       t, fastest, p.grain[fastest], p.v[fastest].norm(), worst, c[g.material],
       material_name(config, static_cast<std::size_t>(g.material)), count, kFastPointFraction);
 }
+
+#define MPMCD_SPEED_CHECK(Dim)                                                        \
+  template std::vector<double> wave_speeds<Dim>(const mpm::Model<Dim>&);              \
+  template std::optional<std::string> fast_wall_warning<Dim>(const io::Config&,       \
+                                                             const mpm::Model<Dim>&); \
+  template std::optional<std::string> fast_point_warning<Dim>(const io::Config&,      \
+                                                              const mpm::Model<Dim>&, double);
+MPMCD_SPEED_CHECK(2)
+MPMCD_SPEED_CHECK(3)
+#undef MPMCD_SPEED_CHECK
 
 }  // namespace mpmcd::app

@@ -24,25 +24,27 @@ bool crossed(double start, double x, double target) {
 
 }  // namespace
 
-double WallProgram::share(double t) const {
+template <int Dim>
+double WallProgram<Dim>::share(double t) const {
   if (!(ramp > 0.0)) return 1.0;
   return std::clamp((t - t_start) / ramp, 0.0, 1.0);
 }
 
-WallLoading::WallLoading(const io::Config& config, const std::vector<walls::Wall<2>>& walls,
-                         const mpm::Model<2>& model)
+template <int Dim>
+WallLoading<Dim>::WallLoading(const io::Config& config, const std::vector<walls::Wall<Dim>>& walls,
+                              const mpm::Model<Dim>& model)
     : active_(config.loading.present), section_(&config.loading), walls0_(walls) {
   box_ = analysis::find_box(walls);
   if (box_) box0_ = analysis::box_at(walls, *box_, 0.0);
   eps_time_ = 1e-9 * config.time.dt;
   const std::size_t nw = walls.size();
-  state_.programs.assign(nw, WallProgram{});
+  state_.programs.assign(nw, WallProgram<Dim>{});
   state_.position.resize(nw);
   for (std::size_t k = 0; k < nw; ++k) state_.position[k] = walls[k].point;
-  state_.velocity.assign(nw, Vec<2>::Zero());
-  state_.force.assign(nw, Vec<2>::Zero());
+  state_.velocity.assign(nw, Vec<Dim>::Zero());
+  state_.force.assign(nw, Vec<Dim>::Zero());
   state_.integral.assign(nw, 0.0);
-  pending_.assign(nw, Vec<2>::Zero());
+  pending_.assign(nw, Vec<Dim>::Zero());
   pending_error_.assign(nw, 0.0);
   integral_time_ = config.loading.integral_time;
   if (!active_) return;
@@ -85,19 +87,22 @@ WallLoading::WallLoading(const io::Config& config, const std::vector<walls::Wall
   }
 }
 
-std::string WallLoading::describe() const {
+template <int Dim>
+std::string WallLoading<Dim>::describe() const {
   return fmt::format(
       "loading: {} stage(s); servo gain g = {:.6g} m/(s Pa) ({}), speed limit {:.6g} m/s ({}){}",
       section_->stages.size(), gain_, gain_source_, max_speed_, speed_source_,
       integral_time_ > 0 ? fmt::format(", integral time {:.6g} s", integral_time_) : "");
 }
 
-analysis::Box WallLoading::box_now() const {
+template <int Dim>
+analysis::Box WallLoading<Dim>::box_now() const {
   // walls(t) anchors each wall at its current position at time t: the box at that same t.
   return analysis::box_at(walls(0.0), *box_, 0.0);
 }
 
-double WallLoading::measured_stress(std::size_t k) const {
+template <int Dim>
+double WallLoading<Dim>::measured_stress(std::size_t k) const {
   if (!box_) return 0.0;
   const analysis::Box box = box_now();
   // sigma = F.n / L (docs/observables.md), F the force of the grains on the wall in the last
@@ -106,18 +111,21 @@ double WallLoading::measured_stress(std::size_t k) const {
                                       analysis::wall_length(box, *box_, k));
 }
 
-analysis::CompactionState WallLoading::compaction(double grain_area) const {
+template <int Dim>
+analysis::CompactionState WallLoading<Dim>::compaction(double grain_area) const {
   if (!box_) return {};
   return analysis::compaction_state(box_now(), box0_, grain_area, vs0_);
 }
 
-void WallLoading::start(double grain_area) {
+template <int Dim>
+void WallLoading<Dim>::start(double grain_area) {
   if (!active_) return;
   vs0_ = grain_area;
   begin_stage(0, 0.0, grain_area);
 }
 
-void WallLoading::begin_stage(std::size_t k, double t, double grain_area) {
+template <int Dim>
+void WallLoading<Dim>::begin_stage(std::size_t k, double t, double grain_area) {
   state_.stage = static_cast<std::int32_t>(k);
   state_.stage_start = t;
   if (k >= section_->stages.size()) return;
@@ -129,11 +137,13 @@ void WallLoading::begin_stage(std::size_t k, double t, double grain_area) {
   for (const io::StageWallSection& e : st.walls) {
     std::size_t w = 0;
     while (walls0_[w].name != e.name) ++w;
-    WallProgram& prog = state_.programs[w];
-    const Vec<2> n = walls0_[w].normal;
-    const Vec<2> v_now = state_.velocity[w];
-    const Vec<2> v_to = e.velocity.empty() ? Vec<2>::Zero() : Vec<2>(e.velocity[0], e.velocity[1]);
-    WallProgram next;
+    WallProgram<Dim>& prog = state_.programs[w];
+    const Vec<Dim> n = walls0_[w].normal;
+    const Vec<Dim> v_now = state_.velocity[w];
+    Vec<Dim> v_to = Vec<Dim>::Zero();
+    if (!e.velocity.empty())
+      for (int a = 0; a < Dim; ++a) v_to[a] = e.velocity[static_cast<std::size_t>(a)];
+    WallProgram<Dim> next;
     next.t_start = t;
     next.ramp = st.ramp;
     if (e.has_stress) {
@@ -157,16 +167,17 @@ void WallLoading::begin_stage(std::size_t k, double t, double grain_area) {
   }
 }
 
-std::vector<walls::Wall<2>> WallLoading::step_walls(double t, double dt) {
-  std::vector<walls::Wall<2>> out = walls0_;
+template <int Dim>
+std::vector<walls::Wall<Dim>> WallLoading<Dim>::step_walls(double t, double dt) {
+  std::vector<walls::Wall<Dim>> out = walls0_;
   for (std::size_t k = 0; k < out.size(); ++k) {
-    const WallProgram& prog = state_.programs[k];
-    Vec<2> v = prog.velocity_at(t + dt);
+    const WallProgram<Dim>& prog = state_.programs[k];
+    Vec<Dim> v = prog.velocity_at(t + dt);
     pending_error_[k] = 0.0;
     if (prog.control == WallControl::kStress) {
       // The servo (docs/loading.md): v_n = clamp(g (e + I/T_i), +-v_max), e = sigma_measured -
       // sigma_target, positive into the domain, so a wall pressed less than its target advances.
-      const Vec<2> n = walls0_[k].normal;
+      const Vec<Dim> n = walls0_[k].normal;
       const double e = measured_stress(k) - prog.stress_at(t + dt);
       const double wanted =
           gain_ * (integral_time_ > 0 ? e + state_.integral[k] / integral_time_ : e);
@@ -183,17 +194,20 @@ std::vector<walls::Wall<2>> WallLoading::step_walls(double t, double dt) {
   return out;
 }
 
-void WallLoading::committed(const mpm::StepStats& st, double dt) {
+template <int Dim>
+void WallLoading<Dim>::committed(const mpm::StepStats& st, double dt) {
   for (std::size_t k = 0; k < pending_.size(); ++k) {
     state_.position[k] += dt * pending_[k];
     state_.velocity[k] = pending_[k];
     state_.integral[k] += dt * pending_error_[k];
-    state_.force[k] = k < st.wall_force.size() ? Vec<2>(st.wall_force[k][0], st.wall_force[k][1])
-                                               : Vec<2>::Zero();
+    state_.force[k] = Vec<Dim>::Zero();
+    if (k < st.wall_force.size())
+      for (int a = 0; a < Dim; ++a) state_.force[k][a] = st.wall_force[k][a];
   }
 }
 
-bool WallLoading::needs_area() const {
+template <int Dim>
+bool WallLoading<Dim>::needs_area() const {
   if (!active_ || finished()) return false;
   // The current stage's until.phi, or the next one's (whose start records the side of Phi).
   const auto k = static_cast<std::size_t>(state_.stage);
@@ -201,23 +215,27 @@ bool WallLoading::needs_area() const {
          (k + 1 < section_->stages.size() && section_->stages[k + 1].until.phi > 0);
 }
 
-std::optional<double> WallLoading::stage_end_time() const {
+template <int Dim>
+std::optional<double> WallLoading<Dim>::stage_end_time() const {
   if (!active_ || finished()) return std::nullopt;
   const auto& u = section_->stages[state_.stage].until;
   if (!(u.time > 0)) return std::nullopt;
   return state_.stage_start + u.time;
 }
 
-bool WallLoading::finished() const {
+template <int Dim>
+bool WallLoading<Dim>::finished() const {
   return active_ && static_cast<std::size_t>(state_.stage) >= section_->stages.size();
 }
 
-const std::string& WallLoading::stage_name() const {
+template <int Dim>
+const std::string& WallLoading<Dim>::stage_name() const {
   const std::size_t k = std::min<std::size_t>(state_.stage, section_->stages.size() - 1);
   return section_->stages[k].name;
 }
 
-std::optional<std::string> WallLoading::advance(double t, double grain_area) {
+template <int Dim>
+std::optional<std::string> WallLoading<Dim>::advance(double t, double grain_area) {
   if (!active_ || finished()) return std::nullopt;
   const std::size_t k = static_cast<std::size_t>(state_.stage);
   const io::StageSection& st = section_->stages[k];
@@ -244,8 +262,9 @@ std::optional<std::string> WallLoading::advance(double t, double grain_area) {
   return line;
 }
 
-std::vector<walls::Wall<2>> WallLoading::walls(double t) const {
-  std::vector<walls::Wall<2>> out = walls0_;
+template <int Dim>
+std::vector<walls::Wall<Dim>> WallLoading<Dim>::walls(double t) const {
+  std::vector<walls::Wall<Dim>> out = walls0_;
   for (std::size_t k = 0; k < out.size(); ++k) {
     out[k].point = state_.position[k];
     out[k].t0 = t;
@@ -254,30 +273,38 @@ std::vector<walls::Wall<2>> WallLoading::walls(double t) const {
   return out;
 }
 
-std::string WallLoading::csv_header() const {
+template <int Dim>
+std::string WallLoading<Dim>::csv_header() const {
   if (!active_) return "";
   std::string h = ",stage";
   for (const auto& w : walls0_)
-    h += ",wall_" + w.name + "_vx,wall_" + w.name + "_vy,wall_" + w.name + "_target";
+    h += ",wall_" + w.name + "_vx,wall_" + w.name + "_vy" +
+         (Dim == 3 ? ",wall_" + w.name + "_vz" : "") + ",wall_" + w.name + "_target";
   return h;
 }
 
-std::string WallLoading::csv_fields(double t) const {
+template <int Dim>
+std::string WallLoading<Dim>::csv_fields(double t) const {
   if (!active_) return "";
   std::string out =
       fmt::format(",{}", std::min<std::size_t>(state_.stage + 1, section_->stages.size()));
   for (std::size_t k = 0; k < walls0_.size(); ++k) {
-    const WallProgram& prog = state_.programs[k];
+    const WallProgram<Dim>& prog = state_.programs[k];
     const double target = prog.control == WallControl::kStress
                               ? prog.stress_at(t)
                               : std::numeric_limits<double>::quiet_NaN();
-    out += fmt::format(",{:.12e},{:.12e},{:.12e}", state_.velocity[k][0], state_.velocity[k][1],
-                       target);
+    if constexpr (Dim == 3)
+      out += fmt::format(",{:.12e},{:.12e},{:.12e},{:.12e}", state_.velocity[k][0],
+                         state_.velocity[k][1], state_.velocity[k][2], target);
+    else
+      out += fmt::format(",{:.12e},{:.12e},{:.12e}", state_.velocity[k][0], state_.velocity[k][1],
+                         target);
   }
   return out;
 }
 
-void WallLoading::restore(LoadingState state) {
+template <int Dim>
+void WallLoading<Dim>::restore(LoadingState<Dim> state) {
   const std::size_t nw = walls0_.size();
   if (state.programs.size() != nw || state.position.size() != nw || state.velocity.size() != nw ||
       state.force.size() != nw || state.integral.size() != nw)
@@ -288,5 +315,10 @@ void WallLoading::restore(LoadingState state) {
         fmt::format("loading stage {} of {}", state.stage + 1, section_->stages.size()));
   state_ = std::move(state);
 }
+
+template struct WallProgram<2>;
+template struct WallProgram<3>;
+template class WallLoading<2>;
+template class WallLoading<3>;
 
 }  // namespace mpmcd::app

@@ -80,17 +80,17 @@ Schema build_schema() {
 
   s.add_table(
       &Config::simulation,
-      "Global settings. Only `dimension = 2` (plane strain) is supported for now; 3 is planned "
-      "and rejected with a message.",
+      "Global settings. `dimension = 2` is plane strain (grains are disks, rectangles or "
+      "packings); `dimension = 3` is 3D (grains are spheres and boxes; docs/three_d.md lists "
+      "what 3D does not have yet: packings, `[output] grains`, the coverage columns).",
       {KeySpec::string("name", &SimulationSection::name,
                        "run name used in output file names (letters, digits, `_ - .`)")
            .nonempty()
            .default_of_member(),
        KeySpec::integer("dimension", &SimulationSection::dimension, "",
-                        "spatial dimension (2 = plane strain)")
+                        "spatial dimension (2 = plane strain, 3 = 3D)")
            .at_least(2)
            .at_most(3)
-           .with_note("3 not yet supported")
            .default_of_member(),
        KeySpec::integer("threads", &SimulationSection::threads, "",
                         "OpenMP threads, 0 = OpenMP default")
@@ -131,25 +131,26 @@ Schema build_schema() {
   s.add_table(
       &Config::grains,
       "One grain, a body seeded with material points, or a packing of grains read from a file. "
-      "`disk` needs `center` and `radius`; `rectangle` needs `min_corner` < `max_corner`; "
-      "`packing` needs `file` (relative to the input file's folder, must exist). Keys of other "
-      "shapes are rejected. A disk or rectangle must lie inside the grid with at least one cell "
-      "of margin on every side (ghost nodes).",
+      "`disk` (2D) and `sphere` (3D) need `center` and `radius`; `rectangle` (2D) and `box` (3D) "
+      "need `min_corner` < `max_corner`; `packing` (2D) needs `file` (relative to the input "
+      "file's folder, must exist). Keys of other shapes are rejected. A grain must lie inside "
+      "the grid with at least one cell of margin on every side (ghost nodes). A sphere is "
+      "seeded on the lattice, its points' volumes scaled to the exact 4/3 pi r^3.",
       {KeySpec::string("shape", &GrainSection::shape, "geometry of the grain")
            .require()
-           .one_of({"disk", "rectangle", "packing"}),
+           .one_of({"disk", "rectangle", "packing", "sphere", "box"}),
        KeySpec::string("material", &GrainSection::material, "name of a `[[materials]]` entry")
            .require()
            .nonempty(),
-       KeySpec::numbers("center", &GrainSection::center, "Dim", "m", "disk center")
-           .with_note("disk"),
-       KeySpec::number("radius", &GrainSection::radius, "m", "disk radius")
+       KeySpec::numbers("center", &GrainSection::center, "Dim", "m", "disk or sphere center")
+           .with_note("disk, sphere"),
+       KeySpec::number("radius", &GrainSection::radius, "m", "disk or sphere radius")
            .greater_than(0.0)
-           .with_note("disk"),
+           .with_note("disk, sphere"),
        KeySpec::numbers("min_corner", &GrainSection::min_corner, "Dim", "m", "lower corner")
-           .with_note("rectangle"),
+           .with_note("rectangle, box"),
        KeySpec::numbers("max_corner", &GrainSection::max_corner, "Dim", "m", "upper corner")
-           .with_note("rectangle"),
+           .with_note("rectangle, box"),
        KeySpec::string("file", &GrainSection::file,
                        "packing CSV file, or a packing input (.toml, docs/packing.md) generated "
                        "by DEM when the run starts; relative to the input file's folder")
@@ -162,10 +163,11 @@ Schema build_schema() {
            .default_of_member(),
        KeySpec::string("seeding", &GrainSection::seeding,
                        "where the points go: `lattice` (grid-aligned sites, spacing h / "
-                       "points_per_cell) or `polar` (disks only: concentric rings of that "
-                       "spacing, outermost point domains tangent to the circle, docs/contact.md)")
+                       "points_per_cell) or `polar` (disks and packings only: concentric rings of "
+                       "that spacing, outermost point domains tangent to the circle, "
+                       "docs/contact.md)")
            .one_of({"lattice", "polar"})
-           .defaults("polar for disk and packing, lattice for rectangle"),
+           .defaults("polar for disk and packing, lattice for rectangle, sphere and box"),
        KeySpec::subtable("initial", &GrainSection::initial, "initial velocity field")
            .defaults("at rest")});
 
@@ -181,7 +183,7 @@ Schema build_schema() {
                         "velocity gradient L, row-major")
            .defaults("zeros"),
        KeySpec::number("angular_velocity", &InitialVelocity::angular_velocity, "rad/s",
-                       "rigid spin about the grain center (2D)")
+                       "rigid spin about the grain center (2D only)")
            .default_of_member(),
        KeySpec::numbers("sine_amplitude", &InitialVelocity::sine_amplitude, "Dim", "m/s",
                         "amplitude of the sine part")
@@ -428,8 +430,9 @@ Schema build_schema() {
       "linearly over `ramp` and then held, until one of its end conditions. A stress-controlled "
       "wall moves along its normal at v_n = clamp(gain (sigma_measured - sigma_target), "
       "-max_speed, max_speed) (a servo; sigma_measured from the wall force of the last step over "
-      "the wall's length between its neighbours, as the `wall_<name>_stress` column), so it "
-      "needs the four walls of a box. With `[loading]`, `walls[].velocity` must be absent or "
+      "the wall's length (3D: area) between its neighbours, as the `wall_<name>_stress` column), "
+      "so it needs the four walls of a box (six in 3D). With `[loading]`, `walls[].velocity` must "
+      "be absent or "
       "zero; the walls start at rest.",
       {KeySpec::number("gain", &LoadingSection::gain, "m/(s Pa)",
                        "servo gain g (speed per stress error)")
@@ -481,7 +484,7 @@ Schema build_schema() {
       "End conditions of a stage, checked after every step; the first reached ends it. Phi, "
       "eps and a wall stress end it when they cross the value from the side they were on at the "
       "stage start (so a stage may load or unload). Phi, eps and stresses are those of the CSV "
-      "(docs/observables.md) and need the four walls of a box.",
+      "(docs/observables.md) and need the four walls of a box (six in 3D).",
       {KeySpec::number("time", &StageUntilSection::time, "s", "duration of the stage")
            .greater_than(0.0)
            .defaults("none"),
@@ -519,7 +522,7 @@ Schema build_schema() {
       &Config::stop,
       "Stop criteria of a compaction (docs/observables.md): the run stops at the first criterion "
       "reached, or at `time.end_time`, and logs which. They need four walls forming a box "
-      "(normals +x, -x, +y, -y). Checked after every step.",
+      "(normals +x, -x, +y, -y; in 3D six, with +z, -z). Checked after every step.",
       {KeySpec::number("phi", &StopSection::phi, "",
                        "stop when the solid fraction Phi = Vs/V reaches this")
            .greater_than(0.0)
@@ -556,7 +559,7 @@ Schema build_schema() {
                         "grain-scale outputs: `<name>_grains_<n>.csv` (per-grain stress, shape, "
                         "contacts) and `<name>_forces_<n>.csv` (contact forces per pair) at every "
                         "snapshot time (vtu_interval), fabric and stress columns in the CSV "
-                        "(docs/observables.md)")
+                        "(docs/observables.md); 2D only")
            .default_of_member()});
 
   s.add_table(

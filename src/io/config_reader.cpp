@@ -62,7 +62,14 @@ class ConfigReader {
     read_walls(r, c);
     read_loading(r, c);
     read_stop(r, c);
-    r.sub(&Config::output).fill(c.output);
+    {
+      const TableReader out = r.sub(&Config::output);
+      out.fill(c.output);
+      if (dim_ == 3 && c.output.grains)
+        out.fail(&OutputSection::grains,
+                 "the grain-scale outputs are 2D only for now (docs/three_d.md): set grains = "
+                 "false in 3D");
+    }
     r.sub(&Config::checkpoint).fill(c.checkpoint);
     return c;
   }
@@ -78,9 +85,6 @@ class ConfigReader {
                fmt::format("expected letters, digits, '_', '-' or '.' only (it names "
                            "output files), got \"{}\"",
                            s.name));
-    if (s.dimension == 3)
-      r.fail(&SimulationSection::dimension,
-             "dimension 3 is not yet supported (3D is planned); use dimension = 2 (plane strain)");
     dim_ = static_cast<std::size_t>(s.dimension);
     ctx_.lengths = {{"Dim", dim_}, {"Dim*Dim", dim_ * dim_}};
   }
@@ -163,10 +167,13 @@ class ConfigReader {
       GrainSection g;
       g.line = r.line();
       r.fill(g);
-      if (g.seeding.empty()) g.seeding = g.shape == "rectangle" ? "lattice" : "polar";
-      if (g.shape == "rectangle" && g.seeding == "polar")
+      check_shape_dimension(r, g.shape);
+      const bool lattice_only = g.shape == "rectangle" || g.shape == "sphere" || g.shape == "box";
+      if (g.seeding.empty()) g.seeding = lattice_only ? "lattice" : "polar";
+      if (lattice_only && g.seeding == "polar")
         r.fail(&GrainSection::seeding,
-               "polar seeding is for disks and packings, not for shape \"rectangle\"");
+               fmt::format("polar seeding is for disks and packings, not for shape \"{}\"{}",
+                           g.shape, dim_ == 3 ? " (3D grains are seeded on the lattice)" : ""));
       if (std::find(names.begin(), names.end(), g.material) == names.end()) {
         std::string msg =
             fmt::format("unknown material \"{}\", defined: {}", g.material, fmt::join(names, ", "));
@@ -175,17 +182,17 @@ class ConfigReader {
         r.fail(&GrainSection::material, msg);
       }
       check_shape_keys(r, g.shape);
-      if (g.shape == "disk") {
+      if (g.shape == "disk" || g.shape == "sphere") {
         std::vector<double> lo(dim_), hi(dim_);
         for (std::size_t a = 0; a < dim_; ++a) {
           lo[a] = g.center[a] - g.radius;
           hi[a] = g.center[a] + g.radius;
         }
-        check_inside_grid(
-            r, c.grid,
-            fmt::format("disk (center {}, radius {} m)", vec_text(g.center), number_text(g.radius)),
-            lo, hi);
-      } else if (g.shape == "rectangle") {
+        check_inside_grid(r, c.grid,
+                          fmt::format("{} (center {}, radius {} m)", g.shape, vec_text(g.center),
+                                      number_text(g.radius)),
+                          lo, hi);
+      } else if (g.shape == "rectangle" || g.shape == "box") {
         for (std::size_t a = 0; a < dim_; ++a)
           if (!(g.min_corner[a] < g.max_corner[a]))
             r.fail(&GrainSection::max_corner,
@@ -193,12 +200,17 @@ class ConfigReader {
                                number_text(g.max_corner[a]), number_text(g.min_corner[a])));
         check_inside_grid(
             r, c.grid,
-            fmt::format("rectangle {} to {}", vec_text(g.min_corner), vec_text(g.max_corner)),
+            fmt::format("{} {} to {}", g.shape, vec_text(g.min_corner), vec_text(g.max_corner)),
             g.min_corner, g.max_corner);
       } else {
         g.file = packing_path(r, g.file);
       }
-      r.sub(&GrainSection::initial).fill(g.initial);
+      const TableReader iv = r.sub(&GrainSection::initial);
+      iv.fill(g.initial);
+      if (dim_ == 3 && g.initial.angular_velocity != 0.0)
+        iv.fail(&InitialVelocity::angular_velocity,
+                "a spin about e_z is 2D only; in 3D give a rigid rotation as the antisymmetric "
+                "`gradient` (row-major 3 x 3)");
       auto zeros = [](std::vector<double>& v, std::size_t n) {
         if (v.empty()) v.assign(n, 0.0);
       };
@@ -230,19 +242,55 @@ class ConfigReader {
     return path.string();
   }
 
+  /// disk, rectangle and packing are 2D shapes, sphere and box 3D ones.
+  void check_shape_dimension(const TableReader& r, const std::string& shape) const {
+    static const std::map<std::string, std::pair<std::size_t, std::string>> shapes = {
+        {"disk", {2, "sphere"}},
+        {"rectangle", {2, "box"}},
+        {"packing", {2, ""}},
+        {"sphere", {3, "disk"}},
+        {"box", {3, "rectangle"}}};
+    const auto it = shapes.find(shape);
+    if (it == shapes.end() || it->second.first == dim_) return;
+    const auto& [dim, other] = it->second;
+    r.fail(&GrainSection::shape,
+           other.empty()
+               ? fmt::format("shape \"{}\" is {}D only, but [simulation] dimension = {} (3D "
+                             "packings are not read yet: give each sphere as a [[grains]] entry)",
+                             shape, dim, dim_)
+               : fmt::format("shape \"{}\" is {}D only, but [simulation] dimension = {}: use "
+                             "shape = \"{}\"",
+                             shape, dim, dim_, other));
+  }
+
   /// Each shape has its keys: required for it, rejected for the others.
-  static void check_shape_keys(const TableReader& r, const std::string& shape) {
+  void check_shape_keys(const TableReader& r, const std::string& shape) const {
+    const std::vector<std::string> ball = {r.name(&GrainSection::center),
+                                           r.name(&GrainSection::radius)};
+    const std::vector<std::string> corners = {r.name(&GrainSection::min_corner),
+                                              r.name(&GrainSection::max_corner)};
     const std::map<std::string, std::vector<std::string>> keys = {
-        {"disk", {r.name(&GrainSection::center), r.name(&GrainSection::radius)}},
-        {"rectangle", {r.name(&GrainSection::min_corner), r.name(&GrainSection::max_corner)}},
-        {"packing", {r.name(&GrainSection::file)}}};
-    for (const auto& [s, names] : keys)
-      for (const auto& k : names) {
-        if (s == shape && !r.has(k))
-          r.fail(k, fmt::format("missing required key for shape \"{}\"", shape));
-        if (s != shape && r.has(k))
-          r.fail(k, fmt::format("key is only for shape \"{}\", not for shape \"{}\"", s, shape));
-      }
+        {"disk", ball},
+        {"rectangle", corners},
+        {"packing", {r.name(&GrainSection::file)}},
+        {"sphere", ball},
+        {"box", corners}};
+    // Each key with its shape in this dimension, checked in the order of the 2D names.
+    const std::string round = dim_ == 3 ? "sphere" : "disk", flat = dim_ == 3 ? "box" : "rectangle";
+    const std::vector<std::pair<std::string, std::string>> owners = {
+        {ball[0], round},
+        {ball[1], round},
+        {r.name(&GrainSection::file), "packing"},
+        {corners[0], flat},
+        {corners[1], flat}};
+    const auto& mine = keys.at(shape);
+    for (const auto& [k, owner] : owners) {
+      const bool needed = std::find(mine.begin(), mine.end(), k) != mine.end();
+      if (needed && !r.has(k))
+        r.fail(k, fmt::format("missing required key for shape \"{}\"", shape));
+      if (!needed && r.has(k))
+        r.fail(k, fmt::format("key is only for shape \"{}\", not for shape \"{}\"", owner, shape));
+    }
   }
 
   /// The box [lo, hi] must lie in the grid shrunk by one cell on every side.
@@ -365,16 +413,28 @@ class ConfigReader {
     }
   }
 
-  /// The walls form a box: exactly four, with normals +x, -x, +y, -y (analysis::find_box).
-  static bool walls_form_box(const std::vector<WallSection>& walls) {
-    int axes[4] = {0, 0, 0, 0};  // +x, -x, +y, -y
+  /// The walls form a box: exactly 2 Dim, with normals +x, -x, +y, -y (and +z, -z in 3D;
+  /// analysis::find_box).
+  bool walls_form_box(const std::vector<WallSection>& walls) const {
+    int axes[6] = {0, 0, 0, 0, 0, 0};  // +x, -x, +y, -y, +z, -z
     for (const auto& w : walls)
-      for (int k = 0; k < 4; ++k) {
-        const double nx = k < 2 ? (k == 0 ? 1.0 : -1.0) : 0.0;
-        const double ny = k < 2 ? 0.0 : (k == 2 ? 1.0 : -1.0);
-        if (std::fabs(w.normal[0] - nx) <= 1e-12 && std::fabs(w.normal[1] - ny) <= 1e-12) ++axes[k];
+      for (std::size_t k = 0; k < 2 * dim_; ++k) {
+        bool match = true;
+        for (std::size_t a = 0; a < dim_; ++a) {
+          const double n = a == k / 2 ? (k % 2 == 0 ? 1.0 : -1.0) : 0.0;
+          match = match && std::fabs(w.normal[a] - n) <= 1e-12;
+        }
+        if (match) ++axes[k];
       }
-    return walls.size() == 4 && axes[0] == 1 && axes[1] == 1 && axes[2] == 1 && axes[3] == 1;
+    bool box = walls.size() == 2 * dim_;
+    for (std::size_t k = 0; k < 2 * dim_; ++k) box = box && axes[k] == 1;
+    return box;
+  }
+
+  /// "four [[walls]] forming a box (normals +x, -x, +y, -y" (six and ±z in 3D), for messages.
+  std::string box_words() const {
+    return dim_ == 3 ? "six [[walls]] forming a box (normals +x, -x, +y, -y, +z, -z"
+                     : "four [[walls]] forming a box (normals +x, -x, +y, -y";
   }
 
   /// The wall named `name` (its index), or an error at `key` of `r` naming the walls defined.
@@ -441,10 +501,8 @@ class ConfigReader {
           u.fail(&StageUntilSection::wall, "key is only for `stress`, which is not given");
         if (un.has_stress) (void)wall_index(u, &StageUntilSection::wall, un.wall, c);
         if (!box && (u.has(&StageUntilSection::phi) || un.has_strain || un.has_stress))
-          u.fail_table(
-              fmt::format("phi, strain and stress need four [[walls]] forming a box "
-                          "(normals +x, -x, +y, -y), got {} walls",
-                          c.walls.size()));
+          u.fail_table(fmt::format("phi, strain and stress need {}), got {} walls", box_words(),
+                                   c.walls.size()));
       }
       const auto wall_tables = q.tables(&StageSection::walls);
       std::vector<std::size_t> seen;
@@ -464,10 +522,9 @@ class ConfigReader {
         if (sw.has_stress) {
           if (!box)
             w.fail(&StageWallSection::stress,
-                   fmt::format("a stress-controlled wall must be one of four [[walls]] forming "
-                               "a box (normals +x, -x, +y, -y: its stress is its force over its "
-                               "length between its neighbours), got {} walls",
-                               c.walls.size()));
+                   fmt::format("a stress-controlled wall must be one of {}: its stress is its "
+                               "force over its {} between its neighbours), got {} walls",
+                               box_words(), dim_ == 3 ? "area" : "length", c.walls.size()));
           double vn = 0;
           for (std::size_t a = 0; a < sw.velocity.size(); ++a)
             vn += sw.velocity[a] * c.walls[k].normal[a];
@@ -497,9 +554,7 @@ class ConfigReader {
     r.fill(s);
     if (!walls_form_box(c.walls) && (s.phi > 0 || s.strain > 0 || s.stress > 0))
       r.fail_table(
-          fmt::format("stop criteria need four [[walls]] forming a box (normals +x, -x, "
-                      "+y, -y), got {} walls",
-                      c.walls.size()));
+          fmt::format("stop criteria need {}), got {} walls", box_words(), c.walls.size()));
   }
 
   const toml::table& root_;

@@ -10,11 +10,12 @@ namespace mpmcd::analysis {
 /// Elastic moduli of the grains entering eq. (10).
 struct GrainModuli {
   double mp = 0;  ///< P-wave modulus M_p = λ + 2μ [Pa]
-  double kp = 0;  ///< 2D bulk modulus K_p = λ + μ [Pa]
+  double kp = 0;  ///< bulk modulus K_p = λ + μ in 2D (plane strain), λ + 2μ/3 in 3D [Pa]
 };
 
-/// Moduli of a Neo-Hookean grain from its Lamé coefficients λ, μ [Pa] (paper §4).
-GrainModuli grain_moduli(double lambda, double mu);
+/// Moduli of a Neo-Hookean grain from its Lamé coefficients λ, μ [Pa] (paper §4) in `dim` = 2 or
+/// 3 dimensions (K_p as materials::Law::bulk_modulus).
+GrainModuli grain_moduli(double lambda, double mu, int dim = 2);
 
 /// Paper eq. (10): σ/M_p = -Z Φ / (Z + M_p/(c1 K_p)) (ln Φ + c2) [-]; negative in compression
 /// (mechanics convention) for Φ > exp(-c2). phi, z [-]; c1 > 0, c2 [-].

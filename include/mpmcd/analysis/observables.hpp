@@ -2,8 +2,10 @@
 /// Observables of the compaction experiment (method.md §6, paper §4; definitions in
 /// docs/observables.md): the box formed by four axis-aligned walls, its height, strain and solid
 /// fraction Φ (paper eq. (9)), wall stresses, the coordination number Z of the grain contact
-/// network and the volume-averaged (Love-Weber) stress of the grains. Pure functions on plain data
-/// (2D).
+/// network and the volume-averaged (Love-Weber) stress of the grains. Pure functions on plain data.
+/// The box, Φ, ε, the wall stresses and the Love-Weber stress are given in 2D and 3D (a 3D box has
+/// two more walls, normals ±z; the height stays along y), and Z from pair_impulses of a 3D
+/// contact problem; the coverage and the per-contact ContactImpulse are 2D.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -23,29 +25,40 @@ struct BoxWalls {
   std::size_t right = 0;   ///< wall with normal -x [-]
   std::size_t bottom = 0;  ///< wall with normal +y [-]
   std::size_t top = 0;     ///< wall with normal -y [-]
+  std::size_t front = 0;   ///< wall with normal +z (3D) [-]
+  std::size_t back = 0;    ///< wall with normal -z (3D) [-]
 };
 
 /// The box at one time.
 struct Box {
   double x_min = 0, x_max = 0;  ///< positions of the left and right walls [m]
   double y_min = 0, y_max = 0;  ///< positions of the bottom and top walls [m]
+  double z_min = 0, z_max = 0;  ///< positions of the front and back walls (3D) [m]
+  int dim = 2;                  ///< spatial dimension of the box [-]
   /// Width x_max - x_min [m].
   double width() const { return x_max - x_min; }
   /// Height h = y_max - y_min [m].
   double height() const { return y_max - y_min; }
-  /// Area V = width h [m^2] (2D: volume per unit thickness).
-  double area() const { return width() * height(); }
+  /// Depth z_max - z_min (3D) [m].
+  double depth() const { return z_max - z_min; }
+  /// Volume V of the box: width h in 2D (per unit thickness) [m^2], width h depth in 3D [m^3].
+  double area() const { return dim == 3 ? width() * height() * depth() : width() * height(); }
 };
 
-/// The four walls form a box when there are exactly four and their normals are +x, -x, +y, -y
-/// (each component within 1e-12 of 0 or ±1); nullopt otherwise.
+/// The walls form a box when there are exactly 2 Dim of them and their normals are +x, -x, +y,
+/// -y (and +z, -z in 3D), each component within 1e-12 of 0 or ±1; nullopt otherwise.
 std::optional<BoxWalls> find_box(std::span<const walls::Wall<2>> walls);
+/// The 3D box: six walls, normals ±x, ±y, ±z.
+std::optional<BoxWalls> find_box(std::span<const walls::Wall<3>> walls);
 
 /// The box bounded by the walls at time t [s]: each wall at walls::Wall::point_at(t).
 Box box_at(std::span<const walls::Wall<2>> walls, const BoxWalls& box, double t);
+/// The 3D box bounded by the walls at time t [s].
+Box box_at(std::span<const walls::Wall<3>> walls, const BoxWalls& box, double t);
 
-/// Length of wall `k` [m] inside the box: the width for the bottom and top walls, the height for
-/// the left and right walls; 0 if k is not one of the box walls.
+/// Measure of wall `k`'s face inside the box: in 2D its length [m] (the width for the bottom and
+/// top walls, the height for the left and right walls), in 3D its area [m^2] (the product of the
+/// two other extents); 0 if k is not one of the box walls.
 double wall_length(const Box& box, const BoxWalls& walls, std::size_t k);
 
 /// The compaction state of paper §4 at one output.
@@ -61,14 +74,22 @@ struct CompactionState {
 /// vs0 [m^2]. With a constant width, ln(Vs/Vs0) = ln(Φ/Φ0) + ε (paper eq. (9)) to round-off.
 CompactionState compaction_state(const Box& box, const Box& box0, double vs, double vs0);
 
-/// Normal stress on a wall [Pa]: σ = F·n / L with F the force of the grains on the wall [N/m],
-/// n its unit normal into the domain and L its length in contact with the box [m]. Mechanics
-/// convention: negative when the grains push on the wall (compression), like paper eq. (10).
-double wall_normal_stress(const Vec<2>& force_on_wall, const Vec<2>& normal, double length);
+/// Normal stress on a wall [Pa]: σ = F·n / L with F the force of the grains on the wall [N/m in
+/// 2D, N in 3D], n its unit normal into the domain and L its length [m] (3D: area [m^2]) in
+/// contact with the box. Mechanics convention: negative when the grains push on the wall
+/// (compression), like paper eq. (10).
+template <int Dim>
+double wall_normal_stress(const Vec<Dim>& force_on_wall, const Vec<Dim>& normal, double length);
 
-/// Volume-averaged (Love-Weber) Cauchy stress of the grains over the area V [m^2]:
-/// σ̄ = (1/V) Σ_p σ_p V_p with V_p the points' current volume (docs/observables.md) [Pa].
-Mat<2> love_weber_stress(const points::PointSet<2>& points, double area);
+/// Volume-averaged (Love-Weber) Cauchy stress of the grains over the volume V [m^2 in 2D, m^3 in
+/// 3D]: σ̄ = (1/V) Σ_p σ_p V_p with V_p the points' current volume (docs/observables.md) [Pa].
+template <int Dim>
+Mat<Dim> love_weber_stress(const points::PointSet<Dim>& points, double area);
+
+extern template double wall_normal_stress<2>(const Vec<2>&, const Vec<2>&, double);
+extern template double wall_normal_stress<3>(const Vec<3>&, const Vec<3>&, double);
+extern template Mat<2> love_weber_stress<2>(const points::PointSet<2>&, double);
+extern template Mat<3> love_weber_stress<3>(const points::PointSet<3>&, double);
 
 /// How the point domains cover the box (docs/observables.md, "Coverage"): each point's domain is
 /// the parallelogram x_p + F_p D_p s, s ∈ [-1, 1]² (D_p its reference half-edge vectors, the
@@ -136,6 +157,14 @@ struct PairImpulse {
 std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulse> contacts,
                                        std::int64_t n_grains);
 
+/// The same straight from a solved contact problem of any dimension: P·n of each contact
+/// (impulse on B along the normal from A to B) summed per pair as above.
+template <int Dim>
+std::vector<PairImpulse> pair_impulses(const contact::Problem<Dim>& problem, std::int64_t n_grains);
+
+extern template std::vector<PairImpulse> pair_impulses<2>(const contact::Problem<2>&, std::int64_t);
+extern template std::vector<PairImpulse> pair_impulses<3>(const contact::Problem<3>&, std::int64_t);
+
 /// The summed normal impulse above which a pair is in contact: settings.relative_threshold times
 /// the largest of any pair (grain-grain or grain-wall) [N s/m]; a pair is in contact when its
 /// sum exceeds this and 0.
@@ -160,5 +189,9 @@ struct Coordination {
 /// 0 if no grain is left. `n_grains` is the number of grains in the system.
 Coordination coordination(std::span<const ContactImpulse> contacts, std::int64_t n_grains,
                           const CoordinationSettings& settings = {});
+
+/// The same from the per-pair sums `pairs` (pair_impulses), e.g. of a 3D contact problem.
+Coordination coordination_of_pairs(std::span<const PairImpulse> pairs, std::int64_t n_grains,
+                                   const CoordinationSettings& settings = {});
 
 }  // namespace mpmcd::analysis

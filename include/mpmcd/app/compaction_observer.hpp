@@ -3,6 +3,9 @@
 /// Vs, ln(Vs/Vs0), wall stresses, σ/M_p of the bottom wall, Love-Weber stress, coverage of the
 /// box by the point domains, coordination Z)
 /// and the [stop] criteria. Wires analysis/ to the model and the solver; used by run_simulation.
+/// In 3D (six walls, normals ±x, ±y, ±z) the box columns are h, width, depth, the box volume, ε,
+/// Φ, Vs, ln(Vs/Vs0), the wall stresses (force over face area) and the six Love-Weber
+/// components, and Z (from the per-pair normal impulses); the coverage is 2D only.
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,12 +18,13 @@
 
 namespace mpmcd::app {
 
-/// Observables of a compaction, measured on the committed state.
+/// Observables of a compaction, measured on the committed state (Dim = 2 or 3).
+template <int Dim = 2>
 class CompactionObserver {
  public:
   /// Reads the walls, the grains' moduli and the initial box and grain area from the model at
   /// t = 0 (call before the first step).
-  CompactionObserver(const io::Config& config, const mpm::Model<2>& model);
+  CompactionObserver(const io::Config& config, const mpm::Model<Dim>& model);
 
   /// The extra CSV header, starting with a comma: the box columns if the walls form a box, the
   /// Z columns if contact is on ("" if neither, so runs without walls keep their columns), and
@@ -29,12 +33,12 @@ class CompactionObserver {
 
   /// The extra CSV fields of the committed state at time t [s], starting with a comma; `step` is
   /// the last converged step (wall forces), `problem` its contact problem (Z).
-  std::string csv_fields(const mpm::Model<2>& model, const mpm::StepStats& step,
-                         const contact::Problem<2>& problem, double t) const;
+  std::string csv_fields(const mpm::Model<Dim>& model, const mpm::StepStats& step,
+                         const contact::Problem<Dim>& problem, double t) const;
 
   /// The first [stop] criterion reached by the committed state at time t [s] (a sentence for the
   /// log), or nullopt.
-  std::optional<std::string> stop_reason(const mpm::Model<2>& model, const mpm::StepStats& step,
+  std::optional<std::string> stop_reason(const mpm::Model<Dim>& model, const mpm::StepStats& step,
                                          double t) const;
   /// The same with the grains' current area V_s [m^2] given (several ranks: the sum over ranks of
   /// grain_areas, so that no rank needs every point).
@@ -54,11 +58,11 @@ class CompactionObserver {
   /// Solid fraction Φ0 at t = 0 (V_s0 over the initial box) [-]; 0 without a box.
   double initial_phi() const;
   /// Coordination number Z of the contact network of `problem` [-]; nullopt without contact.
-  std::optional<double> coordination(const contact::Problem<2>& problem) const;
+  std::optional<double> coordination(const contact::Problem<Dim>& problem) const;
 
   /// Current area of each grain, sum of its points' V_p [m^2]; with `owner`, only the grains
   /// with owner[g] == rank (0 for the others).
-  static std::vector<double> grain_areas(const mpm::Model<2>& model,
+  static std::vector<double> grain_areas(const mpm::Model<Dim>& model,
                                          const std::vector<int>* owner = nullptr, int rank = 0);
   /// V_s = sum over grains, in grain order, of grain_areas [m^2]: the association every V_s of a
   /// run uses, so that per-grain sums gathered from several ranks give the same bits.
@@ -66,7 +70,7 @@ class CompactionObserver {
 
   /// Follows walls whose motion is not their input's constant velocity (app::WallLoading): the
   /// box is then that of `walls` (same order as the input's [[walls]]).
-  void move_walls(const std::vector<walls::Wall<2>>& walls);
+  void move_walls(const std::vector<walls::Wall<Dim>>& walls);
 
   /// Replaces V_s0, the grains' area at t = 0 [m^2] (a restarted run must pass the value of the
   /// original start, e.g. from the first CSV row, since the constructor measures the model it is
@@ -85,7 +89,7 @@ class CompactionObserver {
 
  private:
   const io::Config& config_;
-  std::vector<walls::Wall<2>> walls_;
+  std::vector<walls::Wall<Dim>> walls_;
   std::optional<analysis::BoxWalls> box_;
   analysis::Box box0_;
   double vs0_ = 0;
@@ -94,5 +98,12 @@ class CompactionObserver {
   std::int64_t grains_ = 0;
   double pixel_ = 0;  ///< pixel of the coverage raster, h/8 [m]
 };
+
+/// Deduces the dimension from the model.
+template <int Dim>
+CompactionObserver(const io::Config&, const mpm::Model<Dim>&) -> CompactionObserver<Dim>;
+
+extern template class CompactionObserver<2>;
+extern template class CompactionObserver<3>;
 
 }  // namespace mpmcd::app

@@ -78,5 +78,6 @@ class EnergyLedger {
 inline constexpr double kLedgerTolerance = 1e-3;
 
 extern template class EnergyLedger<2>;
+extern template class EnergyLedger<3>;
 
 }  // namespace mpmcd::app

@@ -18,14 +18,16 @@
 
 namespace mpmcd::app {
 
-/// Writes one VTU snapshot of the points at `path` (velocity, full 3x3 stress with sigma_zz,
-/// pressure -tr(sigma)/3, J, mass, volume, grain).
-void write_points_vtu(const mpm::Model<2>& model, const std::string& path);
+/// Writes one VTU snapshot of the points at `path` (velocity, full 3x3 stress (2D: with
+/// sigma_zz), pressure -tr(sigma)/3, J, mass, volume, grain, domain edges e1..eDim).
+template <int Dim>
+void write_points_vtu(const mpm::Model<Dim>& model, const std::string& path);
 
 /// Writes the contacts of `problem` as points at their nodes to `vtu_path` (normal, normal and
 /// tangential impulse, force, gap, the two bodies; walls as -1 - index) and the force per pair of
 /// bodies, sum P / dt, to the CSV `csv_path`.
-void write_contacts(const mpm::Model<2>& model, const contact::Problem<2>& problem,
+template <int Dim>
+void write_contacts(const mpm::Model<Dim>& model, const contact::Problem<Dim>& problem,
                     const std::string& vtu_path, const std::string& csv_path);
 
 /// Keeps the header and the first `rows` complete rows of the CSV at `path` (drops the rows
@@ -44,18 +46,22 @@ class Outputs {
           const checkpoint::State* restart, const std::string& history = "");
 
   /// Restores the contact series of a restart (only runs with contact write it).
-  void restore_contacts(const mpm::ImplicitSolver<2>& solver);
+  template <int Dim>
+  void restore_contacts(const mpm::ImplicitSolver<Dim>& solver);
   /// Appends the CSV row of the committed state at `step`, time t [s], step dt [s]: the step's
   /// statistics `stats`, the diagnostics `d` and the `extra` fields (starting with a comma).
+  template <int Dim>
   void csv_row(std::int64_t step, double t, double dt, const mpm::StepStats& stats,
-               const mpm::Diagnostics<2>& d, const std::string& extra);
+               const mpm::Diagnostics<Dim>& d, const std::string& extra);
   /// Writes the snapshot of time t [s]: the points, and with contact the contacts of `problem`
   /// and the per-pair forces; adds them to the series. With `[output] grains`, also the
   /// per-grain and contact-force CSVs (grain_outputs.hpp), even when `[output] vtu` is off.
-  void vtu(const mpm::Model<2>& model, const mpm::ImplicitSolver<2>& solver,
-           const contact::Problem<2>& problem, double t);
+  template <int Dim>
+  void vtu(const mpm::Model<Dim>& model, const mpm::ImplicitSolver<Dim>& solver,
+           const contact::Problem<Dim>& problem, double t);
   /// Writes `<name>_last_good.vtu` of the points of `model`; returns its path.
-  std::string last_good(const mpm::Model<2>& model);
+  template <int Dim>
+  std::string last_good(const mpm::Model<Dim>& model);
 
   /// CSV rows written so far (header excluded) [-].
   std::int64_t csv_rows() const { return csv_rows_; }
@@ -74,6 +80,7 @@ class Outputs {
 
   const io::Config& cfg_;
   std::string dir_, csv_path_;
+  int dim_ = 2;  // [simulation] dimension: the CSV's momentum and wall-force columns
   std::ofstream csv_;
   std::unique_ptr<io::PvdSeries> pvd_, contacts_pvd_;
   int vtu_count_ = 0;

@@ -38,11 +38,14 @@ mpm::Model<Dim> restore_model(const io::Config& config, const checkpoint::State&
 template <int Dim>
 std::vector<mpm::WarmImpulse<Dim>> warm_start_of(const checkpoint::State& state);
 
-/// Stores the wall loading's state in `state` (docs/loading.md).
-void store_loading(const LoadingState& loading, checkpoint::State& state);
+/// Stores the wall loading's state in `state` (docs/loading.md): per wall 4 Dim + 5 values
+/// (checkpoint::State::loading_wall).
+template <int Dim>
+void store_loading(const LoadingState<Dim>& loading, checkpoint::State& state);
 /// The wall loading's state held by `state` (walls at state.wall_point). Throws
 /// std::invalid_argument when the checkpoint has none or a malformed one.
-LoadingState loading_state_of(const checkpoint::State& state);
+template <int Dim>
+LoadingState<Dim> loading_state_of(const checkpoint::State& state);
 
 /// Stores the energy ledger's sums in `state`.
 void store_energy(const EnergySums& sums, checkpoint::State& state);
@@ -55,6 +58,16 @@ extern template void store_run<2>(const io::Config&, const mpm::Model<2>&,
 extern template mpm::Model<2> restore_model<2>(const io::Config&, const checkpoint::State&,
                                                const std::string&);
 extern template std::vector<mpm::WarmImpulse<2>> warm_start_of<2>(const checkpoint::State&);
+extern template void store_run<3>(const io::Config&, const mpm::Model<3>&,
+                                  const std::vector<mpm::WarmImpulse<3>>&,
+                                  const std::vector<walls::Wall<3>>&, checkpoint::State&);
+extern template mpm::Model<3> restore_model<3>(const io::Config&, const checkpoint::State&,
+                                               const std::string&);
+extern template std::vector<mpm::WarmImpulse<3>> warm_start_of<3>(const checkpoint::State&);
+extern template void store_loading<2>(const LoadingState<2>&, checkpoint::State&);
+extern template void store_loading<3>(const LoadingState<3>&, checkpoint::State&);
+extern template LoadingState<2> loading_state_of<2>(const checkpoint::State&);
+extern template LoadingState<3> loading_state_of<3>(const checkpoint::State&);
 
 /// A checkpoint and the input of the run it continues.
 struct Restart {

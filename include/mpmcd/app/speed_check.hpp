@@ -23,17 +23,32 @@ inline constexpr double kFastWallFraction = 0.1;
 inline constexpr double kFastPointFraction = 0.5;
 
 /// Elastic (P-)wave speed c = sqrt(M/ρ) of each material of the model [m/s].
-std::vector<double> wave_speeds(const mpm::Model<2>& model);
+template <int Dim>
+std::vector<double> wave_speeds(const mpm::Model<Dim>& model);
 
 /// The warning for the walls whose speed |velocity| exceeds kFastWallFraction times the smallest
 /// wave speed of the materials the grains are made of (naming each such wall, its speed and that
 /// material), or nullopt.
-std::optional<std::string> fast_wall_warning(const io::Config& config, const mpm::Model<2>& model);
+template <int Dim>
+std::optional<std::string> fast_wall_warning(const io::Config& config,
+                                             const mpm::Model<Dim>& model);
 
 /// The warning for the fastest material point whose speed |v| exceeds kFastPointFraction times the
 /// wave speed of its grain's material at time t [s] (naming the point, its grain and the speeds,
 /// and how many points are that fast), or nullopt. O(points).
-std::optional<std::string> fast_point_warning(const io::Config& config, const mpm::Model<2>& model,
-                                              double t);
+template <int Dim>
+std::optional<std::string> fast_point_warning(const io::Config& config,
+                                              const mpm::Model<Dim>& model, double t);
+
+extern template std::vector<double> wave_speeds<2>(const mpm::Model<2>&);
+extern template std::vector<double> wave_speeds<3>(const mpm::Model<3>&);
+extern template std::optional<std::string> fast_wall_warning<2>(const io::Config&,
+                                                                const mpm::Model<2>&);
+extern template std::optional<std::string> fast_wall_warning<3>(const io::Config&,
+                                                                const mpm::Model<3>&);
+extern template std::optional<std::string> fast_point_warning<2>(const io::Config&,
+                                                                 const mpm::Model<2>&, double);
+extern template std::optional<std::string> fast_point_warning<3>(const io::Config&,
+                                                                 const mpm::Model<3>&, double);
 
 }  // namespace mpmcd::app

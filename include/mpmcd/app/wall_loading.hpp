@@ -29,46 +29,51 @@ enum class WallControl : std::int32_t {
 };
 
 /// A wall's program since the stage that last set it: its control and its targets, going
-/// linearly from `from` to `to` over [t_start, t_start + ramp] and held after.
+/// linearly from `from` to `to` over [t_start, t_start + ramp] and held after (Dim = 2 or 3).
+template <int Dim>
 struct WallProgram {
   WallControl control = WallControl::kVelocity;  ///< velocity or stress control
-  Vec<2> v_from = Vec<2>::Zero();  ///< velocity (or slide, stress control) at t_start [m/s]
-  Vec<2> v_to = Vec<2>::Zero();    ///< velocity (or slide) at the ramp's end [m/s]
-  double s_from = 0.0;             ///< target normal stress at t_start [Pa]
-  double s_to = 0.0;               ///< target normal stress at the ramp's end [Pa]
-  double t_start = 0.0;            ///< start of the ramp [s]
-  double ramp = 0.0;               ///< duration of the ramp (0: a step) [s]
+  Vec<Dim> v_from = Vec<Dim>::Zero();  ///< velocity (or slide, stress control) at t_start [m/s]
+  Vec<Dim> v_to = Vec<Dim>::Zero();    ///< velocity (or slide) at the ramp's end [m/s]
+  double s_from = 0.0;                 ///< target normal stress at t_start [Pa]
+  double s_to = 0.0;                   ///< target normal stress at the ramp's end [Pa]
+  double t_start = 0.0;                ///< start of the ramp [s]
+  double ramp = 0.0;                   ///< duration of the ramp (0: a step) [s]
   /// Share of the ramp done at time t [s]: clamp((t - t_start)/ramp, 0, 1), 1 for ramp 0 [-].
   double share(double t) const;
   /// Target velocity (or slide) at time t [s] [m/s].
-  Vec<2> velocity_at(double t) const { return v_from + share(t) * (v_to - v_from); }
+  Vec<Dim> velocity_at(double t) const { return v_from + share(t) * (v_to - v_from); }
   /// Target normal stress at time t [s] [Pa].
   double stress_at(double t) const { return s_from + share(t) * (s_to - s_from); }
 };
 
 /// What a checkpoint carries of the loading (plain data; app::run_state stores it).
+template <int Dim>
 struct LoadingState {
-  std::int32_t stage = 0;             ///< current stage (== number of stages once all ended) [-]
-  double stage_start = 0.0;           ///< time the current stage started [s]
-  double phi0 = 0.0;                  ///< Φ at the stage start (side of until.phi) [-]
-  double eps0 = 0.0;                  ///< ε at the stage start (side of until.strain) [-]
-  double stress0 = 0.0;               ///< stress of until.wall at the stage start [Pa]
-  std::vector<WallProgram> programs;  ///< per wall
-  std::vector<Vec<2>> position;       ///< per wall: a point of its plane at the current time [m]
-  std::vector<Vec<2>> velocity;       ///< per wall: its velocity in the last step [m/s]
-  std::vector<Vec<2>> force;  ///< per wall: force of the grains on it in the last step [N/m]
+  std::int32_t stage = 0;    ///< current stage (== number of stages once all ended) [-]
+  double stage_start = 0.0;  ///< time the current stage started [s]
+  double phi0 = 0.0;         ///< Φ at the stage start (side of until.phi) [-]
+  double eps0 = 0.0;         ///< ε at the stage start (side of until.strain) [-]
+  double stress0 = 0.0;      ///< stress of until.wall at the stage start [Pa]
+  std::vector<WallProgram<Dim>> programs;  ///< per wall
+  std::vector<Vec<Dim>> position;  ///< per wall: a point of its plane at the current time [m]
+  std::vector<Vec<Dim>> velocity;  ///< per wall: its velocity in the last step [m/s]
+  std::vector<Vec<Dim>>
+      force;  ///< per wall: force of the grains on it in the last step [N] (2D: N/m)
   /// Per wall: the servo's integral I of the stress error over time ([loading] integral_time;
   /// 0 when off or while velocity-controlled) [Pa s].
   std::vector<double> integral;
 };
 
 /// The walls' motion under [loading] (inactive without it: the walls keep their input velocity).
+/// In 3D the box has six walls and a wall's stress is its normal force over its face area.
+template <int Dim>
 class WallLoading {
  public:
   /// From the input and the walls at t = 0 (the settings'); `model` gives the grains' density,
   /// P-wave modulus M_p and wave speed for the automatic gain and speed limit.
-  WallLoading(const io::Config& config, const std::vector<walls::Wall<2>>& walls,
-              const mpm::Model<2>& model);
+  WallLoading(const io::Config& config, const std::vector<walls::Wall<Dim>>& walls,
+              const mpm::Model<Dim>& model);
 
   /// True when the input has [loading].
   bool active() const { return active_; }
@@ -83,7 +88,7 @@ class WallLoading {
   void start(double grain_area);
   /// The walls for the step [t, t + dt] [s]: each at its position at t, with the velocity of its
   /// program (a servo's from the last step's force). A retried step calls it again.
-  std::vector<walls::Wall<2>> step_walls(double t, double dt);
+  std::vector<walls::Wall<Dim>> step_walls(double t, double dt);
   /// The step [t, t + dt] given by the last step_walls has been committed with statistics `st`:
   /// positions advance, the force is kept for the next servo step.
   void committed(const mpm::StepStats& st, double dt);
@@ -101,7 +106,7 @@ class WallLoading {
   const std::string& stage_name() const;
 
   /// The walls at time t [s] (after a committed step): the planes the outputs measure.
-  std::vector<walls::Wall<2>> walls(double t) const;
+  std::vector<walls::Wall<Dim>> walls(double t) const;
 
   /// Extra CSV header, starting with a comma: `stage` and per wall its velocity of the last step
   /// and its target stress ("" when inactive).
@@ -110,10 +115,10 @@ class WallLoading {
   std::string csv_fields(double t) const;
 
   /// The state a checkpoint carries.
-  const LoadingState& state() const { return state_; }
+  const LoadingState<Dim>& state() const { return state_; }
   /// Continues from a checkpoint's state (a restart). Throws std::invalid_argument if it does
   /// not fit the input (wall count, stage index).
-  void restore(LoadingState state);
+  void restore(LoadingState<Dim> state);
 
  private:
   // Normal stress of wall k from `force` over its length in the box at the current positions
@@ -128,7 +133,7 @@ class WallLoading {
 
   bool active_ = false;
   const io::LoadingSection* section_ = nullptr;
-  std::vector<walls::Wall<2>> walls0_;     // the walls at t = 0 (names, normals, friction)
+  std::vector<walls::Wall<Dim>> walls0_;   // the walls at t = 0 (names, normals, friction)
   std::optional<analysis::BoxWalls> box_;  // which walls bound the box
   analysis::Box box0_;                     // the box at t = 0
   std::vector<std::size_t> until_wall_;    // per stage: index of until.wall (or 0)
@@ -137,11 +142,16 @@ class WallLoading {
   std::string gain_source_, speed_source_;
   double vs0_ = 0.0;       // grain area at t = 0 [m^2]
   double eps_time_ = 0.0;  // time tolerance of until.time [s]
-  LoadingState state_;
-  std::vector<Vec<2>> pending_;  // velocities of the step being tried [m/s]
+  LoadingState<Dim> state_;
+  std::vector<Vec<Dim>> pending_;  // velocities of the step being tried [m/s]
   // Servo walls of the step being tried: the stress error e [Pa] to integrate when committed,
   // 0 for a velocity-controlled wall or one at its speed limit (no wind-up).
   std::vector<double> pending_error_;
 };
+
+extern template struct WallProgram<2>;
+extern template struct WallProgram<3>;
+extern template class WallLoading<2>;
+extern template class WallLoading<3>;
 
 }  // namespace mpmcd::app

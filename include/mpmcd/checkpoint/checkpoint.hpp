@@ -88,9 +88,10 @@ struct State {
   std::vector<double> loading_stage;
   /// Per wall, app::WallProgram's control: 0 velocity, 1 stress [-].
   std::vector<std::int32_t> loading_control;
-  /// Per wall, 12 values: the program's v_from (dim) [m/s], v_to (dim) [m/s], s_from, s_to [Pa],
-  /// t_start, ramp [s]; the velocity of the last step (dim) [m/s]; the force of the grains on
-  /// it in the last step (dim) [N] (2D: N/m); its position is wall_point.
+  /// Per wall, 4 dim + 5 values (13 in 2D, 17 in 3D; format 7: 4 dim + 4, no integral): the
+  /// program's v_from (dim) [m/s], v_to (dim) [m/s], s_from, s_to [Pa], t_start, ramp [s]; the
+  /// velocity of the last step (dim) [m/s]; the force of the grains on it in the last step (dim)
+  /// [N] (2D: N/m); the servo integral [Pa s]; its position is wall_point.
   std::vector<double> loading_wall;
   // Distribution (docs/parallel.md): restored when the rank count and scheme are the same.
   std::int32_t ranks = 1;                 ///< MPI ranks of the writing run [-]

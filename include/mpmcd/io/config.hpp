@@ -16,7 +16,7 @@ namespace mpmcd::io {
 /// [simulation]: global settings.
 struct SimulationSection {
   std::string name = "mpmcd";  ///< run name used in output file names [-]
-  int dimension = 2;           ///< spatial dimension (2 = plane strain) [-]
+  int dimension = 2;           ///< spatial dimension (2 = plane strain, 3 = 3D) [-]
   int threads = 0;             ///< OpenMP threads, 0 = OpenMP default [-]
 };
 
@@ -51,15 +51,15 @@ struct InitialVelocity {
 
 /// [[grains]]: one grain (a body made of material points).
 struct GrainSection {
-  std::string shape;     ///< "disk", "rectangle" or "packing"
+  std::string shape;     ///< "disk", "rectangle", "packing" (2D); "sphere", "box" (3D)
   std::string material;  ///< material name [-]
   std::string file;      ///< packing file (shape "packing"), resolved against the input's folder
-  std::vector<double> center;      ///< disk center [m] (disk)
-  double radius = 0.0;             ///< disk radius [m] (disk)
-  std::vector<double> min_corner;  ///< lower corner [m] (rectangle)
-  std::vector<double> max_corner;  ///< upper corner [m] (rectangle)
+  std::vector<double> center;      ///< disk or sphere center [m] (disk, sphere)
+  double radius = 0.0;             ///< disk or sphere radius [m] (disk, sphere)
+  std::vector<double> min_corner;  ///< lower corner [m] (rectangle, box)
+  std::vector<double> max_corner;  ///< upper corner [m] (rectangle, box)
   int points_per_cell = 2;         ///< material points per cell along each axis [-]
-  std::string seeding;      ///< "lattice" or "polar" (disks, packings); empty: polar for disks
+  std::string seeding;      ///< "lattice" or "polar" (disks, packings); default polar for disks
   InitialVelocity initial;  ///< initial velocity field
   std::int64_t line = 0;    ///< line of the table in the input
 };

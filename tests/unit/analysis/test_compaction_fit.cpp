@@ -48,6 +48,9 @@ constexpr double kMu = 1.5e6, kC2 = 0.27;
 
 TEST(CompactionLaw, Eq10ValuesAndSign) {
   const GrainModuli m = grain_moduli(3e6, 1.5e6);
+  const GrainModuli m3 = grain_moduli(3e6, 1.5e6, 3);  // 3D: K_p = λ + 2μ/3
+  EXPECT_DOUBLE_EQ(m3.mp, 6e6);
+  EXPECT_DOUBLE_EQ(m3.kp, 4e6);
   EXPECT_DOUBLE_EQ(m.mp, 6e6);
   EXPECT_DOUBLE_EQ(m.kp, 4.5e6);
   // -Z Φ / (Z + M/(c1 K)) (ln Φ + c2) by hand: Z = 4, Φ = 0.9, c1 = 0.23, c2 = 0.27.

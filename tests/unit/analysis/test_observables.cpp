@@ -88,6 +88,42 @@ TEST(Compaction, WallStressIsNegativeInCompression) {
   EXPECT_DOUBLE_EQ(wall_normal_stress(Vec<2>(-30, 0), Vec<2>(-1, 0), 3e-3), 1e4);
 }
 
+// A 3D box of six walls (the order of the walls is free), the top one moving down: the box, its
+// volume, the face areas the stresses divide by, Φ; a tilted or missing wall is no box.
+TEST(Compaction, ThreeDimensionalBoxOfSixWalls) {
+  std::vector<walls::Wall<3>> w = {
+      {"back", Vec<3>(0, 0, 4e-3), Vec<3>(0, 0, -1), Vec<3>::Zero(), 0.0},
+      {"left", Vec<3>(0, 0, 0), Vec<3>(1, 0, 0), Vec<3>::Zero(), 0.0},
+      {"right", Vec<3>(3e-3, 0, 0), Vec<3>(-1, 0, 0), Vec<3>::Zero(), 0.0},
+      {"bottom", Vec<3>(0, 0, 0), Vec<3>(0, 1, 0), Vec<3>::Zero(), 0.0},
+      {"top", Vec<3>(0, 2e-3, 0), Vec<3>(0, -1, 0), Vec<3>(0, -2, 0), 0.0},
+      {"front", Vec<3>(0, 0, 1e-3), Vec<3>(0, 0, 1), Vec<3>::Zero(), 0.0}};
+  const auto b = find_box(w);
+  ASSERT_TRUE(b.has_value());
+  EXPECT_EQ(b->front, 5u);
+  EXPECT_EQ(b->back, 0u);
+  EXPECT_EQ(b->top, 4u);
+  const Box box0 = box_at(w, *b, 0.0), box = box_at(w, *b, 1e-4);
+  EXPECT_EQ(box0.dim, 3);
+  EXPECT_DOUBLE_EQ(box0.area(), 3e-3 * 2e-3 * 3e-3);  // width x height x depth [m^3]
+  EXPECT_DOUBLE_EQ(box.height(), 2e-3 - 2e-4);
+  EXPECT_DOUBLE_EQ(wall_length(box, *b, b->top), 3e-3 * 3e-3);             // width x depth
+  EXPECT_DOUBLE_EQ(wall_length(box, *b, b->left), (2e-3 - 2e-4) * 3e-3);   // height x depth
+  EXPECT_DOUBLE_EQ(wall_length(box, *b, b->front), 3e-3 * (2e-3 - 2e-4));  // width x height
+  const auto s = compaction_state(box, box0, 9e-9, 9e-9);
+  EXPECT_DOUBLE_EQ(s.phi, 9e-9 / box.area());
+  EXPECT_NEAR(s.strain, std::log(0.9), 1e-14);
+  // 1 N on the top face of 9e-6 m^2, pushed up by the grains: -1/9e-6 Pa.
+  EXPECT_DOUBLE_EQ(wall_normal_stress(Vec<3>(0, 1, 0), w[4].normal, wall_length(box, *b, 4)),
+                   -1.0 / 9e-6);
+  auto tilted = w;
+  tilted[5].normal = Vec<3>(0, 0.6, 0.8);
+  EXPECT_FALSE(find_box(tilted).has_value());
+  tilted = w;
+  tilted.pop_back();
+  EXPECT_FALSE(find_box(tilted).has_value());
+}
+
 TEST(LoveWeber, UniformStressOverTheSolidFraction) {
   points::PointSet<2> pts;
   Mat<2> s;

@@ -1,0 +1,216 @@
+// 3D through the command line (issue 18): `mpmcd run` of TOML inputs with `dimension = 3`. A
+// sphere resting on a wall carries its weight; a sphere squeezed in a box of six walls ([loading])
+// has the exact initial Φ and, stopped half way and restarted from its checkpoint, ends with the
+// same bytes in every output; 3D inputs with the wrong number of components, or 2D-only shapes
+// and keys, are refused with exit 2 and a message naming the file, the key and what was expected.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../../support/cli_runner.hpp"
+#include "../../support/scratch.hpp"
+
+namespace fs = std::filesystem;
+using mpmcd::test_support::read_file;
+using mpmcd::test_support::run;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  return mpmcd::test_support::scratch_dir("three_d_app", name);
+}
+
+// The paper's gel (method.md §3) on a grid of 10^3 cells of h = 0.5 mm; a sphere of R = 1.5 mm
+// (912 lattice points, volumes scaled to 4/3 pi R^3).
+const std::string kGelSphere =
+    "[grid]\norigin = [0.0, 0.0, 0.0]\nextent = [0.005, 0.005, 0.005]\ncell_size = 0.0005\n"
+    "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\nlambda = 3e6\n"
+    "mu = 1.5e6\n"
+    "[[grains]]\nshape = \"sphere\"\nmaterial = \"gel\"\ncenter = [0.0025, 0.0025, 0.0025]\n"
+    "radius = 0.0015\n";
+
+fs::path write_input(const fs::path& dir, const std::string& name, const std::string& text) {
+  const fs::path p = dir / (name + ".toml");
+  std::ofstream(p) << text;
+  return p;
+}
+
+// The CSV at `path` as columns by header name (every field parsed as a number).
+std::map<std::string, std::vector<double>> read_csv(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream hs(line);
+  for (std::string f; std::getline(hs, f, ',');) names.push_back(f);
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::size_t k = 0;
+    for (std::string f; std::getline(ls, f, ',') && k < names.size(); ++k)
+      cols[names[k]].push_back(std::stod(f));
+  }
+  return cols;
+}
+
+}  // namespace
+
+// A sphere set on a frictionless floor (normal +z) under gravity, 389 steps of 2h/c_p (as
+// tests/verification/three_d, now from a TOML file): once backward Euler has damped the bouncing,
+// the floor's force over the second half of the run is the sphere's weight within 1 %.
+TEST(ThreeDApp, SphereRestingOnAWallCarriesItsWeight) {
+  const fs::path dir = scratch("rest");
+  const fs::path input = write_input(
+      dir, "rest",
+      "[simulation]\nname = \"rest\"\ndimension = 3\n" + kGelSphere +
+          "[[walls]]\nname = \"floor\"\npoint = [0.0, 0.0, 0.001]\nnormal = [0.0, 0.0, 1.0]\n"
+          "[loads]\ngravity = [0.0, 0.0, -9.81]\n"
+          "[time]\ndt = 1.2845e-5\nend_time = 0.005\n[output]\nvtu = false\n");
+  const auto r = run("run -q -t 2 -o " + (dir / "out").string() + " " + input.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  auto csv = read_csv(dir / "out" / "rest.csv");
+  const auto& t = csv["time"];
+  ASSERT_GT(t.size(), 300u);
+  const double T = t.back(), mass = csv["mass"].back(), weight = 9.81 * mass;
+  // The exact sphere volume times the density (lattice points, volumes rescaled).
+  EXPECT_NEAR(mass, 990.0 * 4.0 / 3.0 * std::numbers::pi * std::pow(1.5e-3, 3), 1e-12 * mass);
+  double impulse = 0, time = 0;  // the floor's reaction on the sphere over the second half
+  for (std::size_t k = 1; k < t.size(); ++k)
+    if (t[k] > 0.5 * T) {
+      const double dt = t[k] - t[k - 1];
+      impulse += -csv["wall_floor_fz"][k] * dt;
+      time += dt;
+    }
+  const double ratio = impulse / time / weight;
+  std::printf("  %zu steps to %.4g s: floor force / weight over the second half %.6f\n",
+              t.size() - 1, T, ratio);
+  EXPECT_NEAR(ratio, 1.0, 0.01);
+  EXPECT_EQ(csv["wall_floor_fx"].size(), t.size());  // the 3 components are written
+}
+
+// Two spheres (R = 1 mm) stacked along y in a box of six walls, the top one (normal -y) moving
+// down at 0.5 m/s ([loading]): Φ0 = 2 (4/3 pi R^3) / V_box exactly; at the end the top and
+// bottom walls carry the same load, close to the grains' Love-Weber σ_yy (not equal: the loading
+// is not quasi-static), and the two spheres in contact with each other and a wall each give
+// Z = 2 N_pairs / N_grains = 1; a run stopped after 20 steps and restarted from its checkpoint
+// ends with the same CSV, VTU, PVD and pair files and the same final checkpoint, byte for byte.
+TEST(ThreeDApp, SqueezedSpheresRestartBitwise) {
+  const fs::path dir = scratch("squeeze");
+  std::string walls;
+  const char* names[6] = {"left", "right", "bottom", "top", "front", "back"};
+  const double at[6] = {0.001, 0.003, 0.001, 0.0051, 0.0009, 0.0031};
+  for (int k = 0; k < 6; ++k) {
+    double n[3] = {0, 0, 0}, x[3] = {0, 0, 0};
+    n[k / 2] = k % 2 == 0 ? 1.0 : -1.0;
+    x[k / 2] = at[k];
+    std::ostringstream w;
+    w << "[[walls]]\nname = \"" << names[k] << "\"\npoint = [" << x[0] << ", " << x[1] << ", "
+      << x[2] << "]\nnormal = [" << n[0] << ", " << n[1] << ", " << n[2] << "]\n";
+    walls += w.str();
+  }
+  const fs::path input = write_input(
+      dir, "squeeze",
+      "[simulation]\nname = \"squeeze\"\ndimension = 3\n"
+      "[grid]\norigin = [0.0, 0.0, 0.0]\nextent = [0.004, 0.006, 0.004]\ncell_size = 0.0005\n"
+      "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\nlambda = 3e6\n"
+      "mu = 1.5e6\n"
+      "[[grains]]\nshape = \"sphere\"\nmaterial = \"gel\"\ncenter = [0.002, 0.002, 0.002]\n"
+      "radius = 0.001\n"
+      "[[grains]]\nshape = \"sphere\"\nmaterial = \"gel\"\ncenter = [0.002, 0.004, 0.002]\n"
+      "radius = 0.001\n" +
+          walls +
+          "[loading]\n[[loading.stages]]\nname = \"squeeze\"\n[[loading.stages.walls]]\n"
+          "name = \"top\"\nvelocity = [0.0, -0.5, 0.0]\n"
+          "[time]\ndt = 2e-5\nend_time = 0.0008\n[output]\nvtu_interval = 2e-4\n");
+  const fs::path full = dir / "full", split = dir / "split";
+  const auto a = run("run -q -t 2 -o " + full.string() + " " + input.string());
+  ASSERT_EQ(a.code, 0) << a.output;
+  const auto b = run("run -q -t 2 --stop-after 20 -o " + split.string() + " " + input.string());
+  ASSERT_EQ(b.code, 4) << b.output;
+  const auto c =
+      run("run -q -t 2 --restart " + (split / "squeeze_checkpoint_000000020.h5").string());
+  ASSERT_EQ(c.code, 0) << c.output;
+
+  auto csv = read_csv(full / "squeeze.csv");
+  const double vs0 = 2 * 4.0 / 3.0 * std::numbers::pi * std::pow(1e-3, 3);
+  const double v0 = 2e-3 * 4.1e-3 * 2.2e-3;
+  EXPECT_NEAR(csv["phi"].front(), vs0 / v0, 1e-12);
+  EXPECT_NEAR(csv["box_volume"].front(), v0, 1e-12 * v0);
+  const double top = csv["wall_top_stress"].back(), bottom = csv["wall_bottom_stress"].back();
+  const double lw = csv["lw_syy"].back();
+  std::printf(
+      "  Phi %.6f -> %.6f; sigma_top %.4g Pa, sigma_bottom %.4g Pa, Love-Weber %.4g Pa; Z %.3g "
+      "(%g pairs, %g grains, %g rattlers)\n",
+      csv["phi"].front(), csv["phi"].back(), top, bottom, lw, csv["Z"].back(),
+      csv["Z_pairs"].back(), csv["Z_grains"].back(), csv["rattlers"].back());
+  EXPECT_GT(csv["phi"].back(), csv["phi"].front());
+  EXPECT_LT(top, 0.0);  // compression
+  EXPECT_NEAR(bottom / top, 1.0, 0.05);
+  EXPECT_NEAR(lw / top, 1.0, 0.1);
+  EXPECT_EQ(csv["Z"].back(), 1.0);
+  EXPECT_EQ(csv["Z_pairs"].back(), 1.0);
+  EXPECT_EQ(csv["rattlers"].back(), 0.0);
+
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(full)) {
+    const std::string name = e.path().filename().string(), ext = e.path().extension().string();
+    if (name.ends_with("_timers.csv") || (ext != ".csv" && ext != ".vtu" && ext != ".pvd"))
+      continue;
+    ++files;
+    EXPECT_TRUE(read_file(e.path()) == read_file(split / name)) << name << " differs";
+  }
+  EXPECT_GE(files, 10);
+  const std::string last = "squeeze_checkpoint_000000040.h5";
+  EXPECT_TRUE(read_file(full / last) == read_file(split / last)) << "final checkpoints differ";
+}
+
+// Bad 3D inputs: exit 2, nothing run, and the message names the file, the key and what it
+// expected.
+TEST(ThreeDApp, BadInputsAreRefusedWithExitTwo) {
+  const fs::path dir = scratch("bad");
+  const std::string head = "[simulation]\nname = \"bad\"\ndimension = 3\n";
+  const std::string tail = "[time]\ndt = 1e-5\nend_time = 1e-4\n";
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = kGelSphere;
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return s.replace(at, from.size(), to);
+  };
+  struct Case {
+    std::string name, text, key, says;
+  };
+  const std::vector<Case> cases = {
+      {"center",
+       head + with("center = [0.0025, 0.0025, 0.0025]", "center = [0.0025, 0.0025]") + tail,
+       "grains[0].center", "expected an array of 3 finite numbers [m], got 2 entries"},
+      {"extent", head + with("extent = [0.005, 0.005, 0.005]", "extent = [0.005, 0.005]") + tail,
+       "grid.extent", "expected an array of 3"},
+      {"normal",
+       head + kGelSphere +
+           "[[walls]]\nname = \"floor\"\npoint = [0.0, 0.0, 0.0009]\nnormal = [0.0, 1.0]\n" + tail,
+       "walls[0].normal", "expected an array of 3 finite numbers, got 2 entries"},
+      {"gravity", head + kGelSphere + "[loads]\ngravity = [0.0, -9.81]\n" + tail, "loads.gravity",
+       "expected an array of 3"},
+      {"disk", head + with("shape = \"sphere\"", "shape = \"disk\"") + tail, "grains[0].shape",
+       "shape \"disk\" is 2D only, but [simulation] dimension = 3: use shape = \"sphere\""},
+      {"spin", head + kGelSphere + "[grains.initial]\nangular_velocity = 10.0\n" + tail,
+       "grains[0].initial.angular_velocity", "2D only"},
+      {"grains_output", head + kGelSphere + tail + "[output]\ngrains = true\n", "output.grains",
+       "2D only"}};
+  for (const auto& c : cases) {
+    const fs::path input = write_input(dir, c.name, c.text);
+    const auto r = run("run -q -o " + (dir / ("out_" + c.name)).string() + " " + input.string());
+    EXPECT_EQ(r.code, 2) << c.name << ": " << r.output;
+    EXPECT_NE(r.output.find(input.filename().string()), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("'" + c.key + "'"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / ("out_" + c.name))) << c.name << ": wrote outputs";
+  }
+}
