@@ -103,11 +103,23 @@ void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t
   packing::Packing pk;
   if (fs::path(g.file).extension() == ".toml") {  // a packing input: generate it now (seeded DEM)
     const auto input = packing::load_packing_input(g.file);
+    if (input.params.dimension != 2)
+      throw InputError(g.file, 0, "packing.dimension",
+                       fmt::format("a 2D run (grains[{}], {}:{}) needs a packing of disks "
+                                   "(dimension = 2), got dimension = {}: spheres are not yet "
+                                   "read as grains (docs/three_d.md)",
+                                   index, cfg.source_path, g.line, input.params.dimension));
     check_packing_box(input.params, model.grid, cfg, index);
     pk = packing::generate_packing(input.params);
     log().info("generated from {}: {}", g.file, packing::summary_line(pk));
   } else {
     pk = packing::read_packing_csv(g.file);
+    if (pk.dimension != 2)
+      throw InputError(g.file, 0, "dimension",
+                       fmt::format("a 2D run (grains[{}], {}:{}) needs a packing of disks, got a "
+                                   "packing of dimension {}: spheres are not yet read as grains "
+                                   "(docs/three_d.md)",
+                                   index, cfg.source_path, g.line, pk.dimension));
   }
   const double h = model.grid.cell_size();
   const Vec<2> lo = model.grid.origin().array() + h, hi = model.grid.upper().array() - h;

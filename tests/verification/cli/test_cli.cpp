@@ -208,6 +208,17 @@ TEST(Cli, PackInThreeDimensionsAndItsBadKeys) {
   const std::string text((std::istreambuf_iterator<char>(csv)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("# dimension = 3\n"), std::string::npos) << text.substr(0, 200);
   EXPECT_NE(text.find("\nid,x,y,z,radius\n"), std::string::npos) << text.substr(0, 200);
+  // A 2D run given the sphere packing (its CSV, or its input to generate) is refused, naming the
+  // dimension (spheres are not yet read as grains).
+  for (const std::string file : {"out/packing.csv", "pack.toml"}) {
+    const fs::path in = write_input(
+        dir, "[[grains]]\nshape = \"packing\"\nfile = \"" + file + "\"\nmaterial = \"gel\"\n",
+        "[time]\ndt = 1e-5\nend_time = 2e-5\n");
+    const Result r = run("check " + in.string());
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("needs a packing of disks"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("dimension"), std::string::npos) << r.output;
+  }
 
   const std::pair<std::string, std::string> bad[] = {
       {"[packing]\ndimension = 1\ncount = 50\n",
