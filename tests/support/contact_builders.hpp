@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "builders.hpp"
+#include "stepping.hpp"
 
 namespace mpmcd::test_support {
 
@@ -140,16 +141,7 @@ inline SqueezeResult run_squeeze(const SqueezeSetup& su) {
   for (std::size_t p = 0; p < model.points.size(); ++p) v0 += model.points.volume0[p];
   while (t < t_end * (1 - 1e-12)) {
     double dt = std::min(res.dt, t_end - t);
-    mpm::StepStats st;
-    int cuts = 0;
-    for (;;) {
-      solver.set_time(t);
-      st = solver.solve_step(dt);
-      if (st.converged || !st.retryable || cuts == 6) break;
-      dt *= 0.5;
-      ++cuts;
-      ++res.cuts;
-    }
+    const mpm::StepStats st = step_with_cuts(solver, t, dt, 6, res.cuts);
     if (!st.converged) {
       res.ok = false;
       res.failure = st.failure;

@@ -19,6 +19,7 @@
 #include "mpmcd/mpm/model.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "mpmcd/points/seeding.hpp"
+#include "stepping.hpp"
 
 namespace mpmcd::test_support {
 
@@ -212,14 +213,7 @@ inline SphereSqueezeResult run_sphere_squeeze(const SphereSqueezeSetup& su) {
   double t = 0, next = window, wt = 0, wdelta = 0, imp_top = 0, imp_bottom = 0;
   while (t < t_end * (1 - 1e-12)) {
     double dt = std::min(res.dt, t_end - t);
-    mpm::StepStats st;
-    for (int cuts = 0;; ++cuts) {
-      solver.set_time(t);
-      st = solver.solve_step(dt);
-      if (st.converged || !st.retryable || cuts == su.max_cuts) break;
-      dt *= 0.5;
-      ++res.cuts;
-    }
+    const mpm::StepStats st = step_with_cuts(solver, t, dt, su.max_cuts, res.cuts);
     if (!st.converged) {
       res.ok = false;
       res.failure = st.failure;
