@@ -54,111 +54,151 @@ Vec<Dim> initial_velocity(const io::InitialVelocity& iv, const Vec<Dim>& c, cons
   return v;
 }
 
-// Every disk of a packing file becomes a grain (points from packing::seed_packing, which gives a
-// lattice site shared by two overlapping disks to one of them only).
 // Grain outlines for the overlap check, and what each one is (grain index, packing disk id or -1).
 struct Outlines {
   std::vector<packing::Outline> shapes;
   std::vector<std::pair<std::size_t, std::int64_t>> owner;
 };
 
+// A 3D grain for the overlap check: a box or a sphere, with what it is.
+struct Solid3 {
+  Vec<3> lo, hi;          // box corners [m] (a sphere: its center in lo and hi)
+  double radius = 0.0;    // sphere radius, 0 for a box [m]
+  std::int64_t id = -1;   // sphere id in a packing file, -1 for a [[grains]] sphere or box [-]
+  std::size_t grain = 0;  // index of its [[grains]] entry [-]
+};
+
+// Center of a packing's disk (2D) or sphere (3D) [m].
+template <int Dim>
+Vec<Dim> disk_center(const packing::Disk& d) {
+  if constexpr (Dim == 2)
+    return Vec<2>(d.x, d.y);
+  else
+    return Vec<3>(d.x, d.y, d.z);
+}
+
+// "[a, b] x [c, d] (x [e, f])" of a box [lo, hi] [m].
+template <int Dim>
+std::string box_text(const Vec<Dim>& lo, const Vec<Dim>& hi) {
+  std::vector<std::string> sides;
+  for (int a = 0; a < Dim; ++a) sides.push_back(fmt::format("[{:.6g}, {:.6g}]", lo[a], hi[a]));
+  return fmt::format("{}", fmt::join(sides, " x "));
+}
+
 // Refuses a packing input whose box cannot fit inside the grid (one cell of margin) before the
 // DEM runs (issue 17: 20,000 disks took 18 s to be refused). The box is known when given; else
-// its smallest possible size follows from the smallest disks at the target packing fraction
-// (grow, walls) or at Phi = 1 (jam, whose final Phi is found by the run).
-void check_packing_box(const packing::PackingParams& p, const grid::Grid<2>& grid,
+// its smallest possible size follows from the smallest grains at the target packing fraction
+// (grow, walls) or at Phi = 1 (jam, whose final Phi is found by the run), with the box shapes of
+// packing::generate_packing (3D: W x W x H, W / H = aspect_ratio).
+template <int Dim>
+void check_packing_box(const packing::PackingParams& p, const grid::Grid<Dim>& grid,
                        const io::Config& cfg, std::size_t index) {
   const auto& g = cfg.grains[index];
   const double h = grid.cell_size();
-  const Vec<2> lo = grid.origin().array() + h, hi = grid.upper().array() - h;
-  Vec<2> b0, b1;
+  const Vec<Dim> lo = grid.origin().array() + h, hi = grid.upper().array() - h;
+  Vec<Dim> b0, b1;
   if (p.box) {
-    b0 = Vec<2>((*p.box)[0], (*p.box)[1]);
-    b1 = Vec<2>((*p.box)[2], (*p.box)[3]);
+    b0.template head<2>() = Vec<2>((*p.box)[0], (*p.box)[1]);
+    b1.template head<2>() = Vec<2>((*p.box)[2], (*p.box)[3]);
+    if constexpr (Dim == 3) b0[2] = p.box_z[0], b1[2] = p.box_z[1];
   } else {
-    double area = 0;  // smallest possible disk area [m^2]
+    double measure = 0;  // smallest possible grain area (3D: volume) [m^Dim]
     if (!p.diameters.empty())
-      for (const double d : p.diameters) area += std::numbers::pi * 0.25 * d * d;
+      for (const double d : p.diameters) measure += points::ball_measure<Dim>(0.5 * d);
     else
-      area =
-          static_cast<double>(p.count) * std::numbers::pi * 0.25 * p.diameter_min * p.diameter_min;
+      measure = static_cast<double>(p.count) * points::ball_measure<Dim>(0.5 * p.diameter_min);
     const double phi = p.method == packing::PackingMethod::kJam ? 1.0 : p.target_phi;
-    b0 = Vec<2>(p.origin[0], p.origin[1]);
-    b1 =
-        b0 + Vec<2>(std::sqrt(area / phi * p.aspect_ratio), std::sqrt(area / phi / p.aspect_ratio));
+    const double a = p.aspect_ratio;
+    b0.template head<2>() = Vec<2>(p.origin[0], p.origin[1]);
+    if constexpr (Dim == 2) {
+      b1 = b0 + Vec<2>(std::sqrt(measure / phi * a), std::sqrt(measure / phi / a));
+    } else {
+      b0[2] = p.origin_z;
+      const double height = std::cbrt(measure / phi / (a * a));
+      b1 = b0 + Vec<3>(a * height, a * height, height);
+    }
   }
   if ((b0.array() < lo.array()).any() || (b1.array() > hi.array()).any())
     throw InputError(g.file, 0, "packing",
-                     fmt::format("the packing box [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] m{} must lie "
-                                 "inside the grid with one cell of margin, [{:.6g}, {:.6g}] x "
-                                 "[{:.6g}, {:.6g}] m (grains[{}], {}:{}); checked before the DEM "
+                     fmt::format("the packing box {} m{} must lie inside the grid with one cell "
+                                 "of margin, {} m (grains[{}], {}:{}); checked before the DEM "
                                  "runs",
-                                 b0[0], b1[0], b0[1], b1[1], p.box ? "" : " (at least)", lo[0],
-                                 hi[0], lo[1], hi[1], index, cfg.source_path, g.line));
+                                 box_text<Dim>(b0, b1), p.box ? "" : " (at least)",
+                                 box_text<Dim>(lo, hi), index, cfg.source_path, g.line));
 }
 
-void add_packing_grains(mpm::Model<2>& model, const io::Config& cfg, std::size_t index,
-                        int material, Outlines& outlines) {
+// Every disk (sphere) of a packing file or input becomes a grain: on polar rings (2D) or on the
+// lattice (points from packing::seed_packing, which gives a lattice site shared by two
+// overlapping grains to one of them only). Their outlines go to the overlap check.
+template <int Dim>
+void add_packing_grains(mpm::Model<Dim>& model, const io::Config& cfg, std::size_t index,
+                        int material, Outlines& outlines, std::vector<Solid3>& solids3d) {
   const auto& g = cfg.grains[index];
+  constexpr const char* kNoun = Dim == 2 ? "disk" : "sphere";
+  const auto wrong_dimension = [&](int got) {
+    return fmt::format(
+        "a {}D run (grains[{}], {}:{}) needs a packing of {}s (dimension = {}), "
+        "got dimension = {}: set [simulation] dimension = {} to run it",
+        Dim, index, cfg.source_path, g.line, kNoun, Dim, got, got);
+  };
   packing::Packing pk;
   if (fs::path(g.file).extension() == ".toml") {  // a packing input: generate it now (seeded DEM)
     const auto input = packing::load_packing_input(g.file);
-    if (input.params.dimension != 2)
-      throw InputError(g.file, 0, "packing.dimension",
-                       fmt::format("a 2D run (grains[{}], {}:{}) needs a packing of disks "
-                                   "(dimension = 2), got dimension = {}: spheres are not yet "
-                                   "read as grains (docs/three_d.md)",
-                                   index, cfg.source_path, g.line, input.params.dimension));
-    check_packing_box(input.params, model.grid, cfg, index);
+    if (input.params.dimension != Dim)
+      throw InputError(g.file, 0, "packing.dimension", wrong_dimension(input.params.dimension));
+    check_packing_box<Dim>(input.params, model.grid, cfg, index);
     pk = packing::generate_packing(input.params);
     log().info("generated from {}: {}", g.file, packing::summary_line(pk));
   } else {
     pk = packing::read_packing_csv(g.file);
-    if (pk.dimension != 2)
-      throw InputError(g.file, 0, "dimension",
-                       fmt::format("a 2D run (grains[{}], {}:{}) needs a packing of disks, got a "
-                                   "packing of dimension {}: spheres are not yet read as grains "
-                                   "(docs/three_d.md)",
-                                   index, cfg.source_path, g.line, pk.dimension));
+    if (pk.dimension != Dim)
+      throw InputError(g.file, 0, "dimension", wrong_dimension(pk.dimension));
   }
   const double h = model.grid.cell_size();
-  const Vec<2> lo = model.grid.origin().array() + h, hi = model.grid.upper().array() - h;
+  const Vec<Dim> lo = model.grid.origin().array() + h, hi = model.grid.upper().array() - h;
   for (const auto& d : pk.disks) {
-    const Vec<2> c(d.x, d.y);
+    const Vec<Dim> c = disk_center<Dim>(d);
     if (((c.array() - d.radius) < lo.array()).any() || ((c.array() + d.radius) > hi.array()).any())
-      throw InputError(g.file, 0, fmt::format("disk {}", d.id),
-                       fmt::format("the disk (center {:.6g} {:.6g} m, radius {:.6g} m) must lie "
-                                   "inside the grid with one cell of margin (grains[{}], {}:{})",
-                                   d.x, d.y, d.radius, index, cfg.source_path, g.line));
-    outlines.shapes.push_back({d.x, d.y, 0.0, 0.0, d.radius});
-    outlines.owner.emplace_back(index, d.id);
-  }
-  if (g.seeding == "polar") {  // each disk on its own rings, strictly inside its circle
-    const double s = h / g.points_per_cell;
-    double estimate = 0;
-    for (const auto& d : pk.disks) estimate += std::numbers::pi * d.radius * d.radius / (s * s);
-    if (estimate > 2e8)
-      throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].points_per_cell", index),
-                       fmt::format("the packing would need about {:.3g} material points (at most "
-                                   "2e8): coarsen the grid or lower points_per_cell",
-                                   estimate));
-    for (const auto& d : pk.disks) {
-      const Vec<2> c(d.x, d.y);
-      model.add_grain(points::seed_disk_polar(c, d.radius, h / g.points_per_cell), material,
-                      0.5 * h / g.points_per_cell,
-                      [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
+      throw InputError(
+          g.file, 0, fmt::format("{} {}", kNoun, d.id),
+          fmt::format("the {} (center {:.6g} m, radius {:.6g} m) must lie inside the "
+                      "grid with one cell of margin (grains[{}], {}:{})",
+                      kNoun, fmt::join(c, " "), d.radius, index, cfg.source_path, g.line));
+    if constexpr (Dim == 2) {
+      outlines.shapes.push_back({d.x, d.y, 0.0, 0.0, d.radius});
+      outlines.owner.emplace_back(index, d.id);
+    } else {
+      solids3d.push_back({c, c, d.radius, d.id, index});
     }
-    return;
   }
-  const auto seeded = packing::seed_packing(pk, model.grid.origin(), h, g.points_per_cell);
+  if constexpr (Dim == 2) {
+    if (g.seeding == "polar") {  // each disk on its own rings, strictly inside its circle
+      const double s = h / g.points_per_cell;
+      double estimate = 0;
+      for (const auto& d : pk.disks) estimate += std::numbers::pi * d.radius * d.radius / (s * s);
+      if (estimate > 2e8)
+        throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].points_per_cell", index),
+                         fmt::format("the packing would need about {:.3g} material points (at "
+                                     "most 2e8): coarsen the grid or lower points_per_cell",
+                                     estimate));
+      for (const auto& d : pk.disks) {
+        const Vec<2> c(d.x, d.y);
+        model.add_grain(points::seed_disk_polar(c, d.radius, h / g.points_per_cell), material,
+                        0.5 * h / g.points_per_cell,
+                        [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
+      }
+      return;
+    }
+  }
+  const auto seeded = packing::seed_packing<Dim>(pk, model.grid.origin(), h, g.points_per_cell);
   for (std::size_t k = 0; k < pk.disks.size(); ++k) {
-    points::Seeds<2> seeds;
+    points::Seeds<Dim> seeds;
     seeds.x.assign(seeded.x.begin() + seeded.offset[k], seeded.x.begin() + seeded.offset[k + 1]);
     seeds.volume.assign(seeded.volume.begin() + seeded.offset[k],
                         seeded.volume.begin() + seeded.offset[k + 1]);
-    const Vec<2> c(pk.disks[k].x, pk.disks[k].y);
+    const Vec<Dim> c = disk_center<Dim>(pk.disks[k]);
     model.add_grain(seeds, material, 0.5 * h / g.points_per_cell,
-                    [&](const Vec<2>& x) { return initial_velocity(g.initial, c, x); });
+                    [&](const Vec<Dim>& x) { return initial_velocity<Dim>(g.initial, c, x); });
   }
 }
 
@@ -183,20 +223,31 @@ void check_no_overlap(const io::Config& cfg, const Outlines& outlines) {
                   o->depth / o->size));
 }
 
-// The 3D grains (spheres and boxes, in input order) may touch but not overlap: the depth of the
-// deepest overlap of a pair, above packing::kOverlapTolerance of the smaller one's size, is
-// refused as check_no_overlap does in 2D.
-struct Solid3 {
-  Vec<3> lo, hi;        // box corners [m] (a sphere: its center in lo, hi unused)
-  double radius = 0.0;  // sphere radius, 0 for a box [m]
-};
-
+// The 3D grains (spheres, boxes and packings' spheres, in input order) may touch but not overlap:
+// the depth of a pair's overlap, above packing::kOverlapTolerance of the smaller one's size, is
+// refused as check_no_overlap does in 2D. Sort and sweep along x: pairs whose x ranges meet.
 void check_no_overlap_3d(const io::Config& cfg, const std::vector<Solid3>& solids) {
   const auto size = [](const Solid3& s) {
     return s.radius > 0 ? 2 * s.radius : (s.hi - s.lo).minCoeff();
   };
-  for (std::size_t j = 0; j < solids.size(); ++j)
-    for (std::size_t i = 0; i < j; ++i) {
+  const auto lower = [](const Solid3& s) { return s.radius > 0 ? s.lo[0] - s.radius : s.lo[0]; };
+  const auto upper = [](const Solid3& s) { return s.radius > 0 ? s.lo[0] + s.radius : s.hi[0]; };
+  const auto describe = [&](const Solid3& s) {
+    const auto& g = cfg.grains[s.grain];
+    return s.id >= 0 ? fmt::format("sphere id {} of {} (grains[{}], line {})", s.id, g.file,
+                                   s.grain, g.line)
+                     : fmt::format("grains[{}] (line {})", s.grain, g.line);
+  };
+  std::vector<std::size_t> order(solids.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return lower(solids[a]) < lower(solids[b]); });
+  for (std::size_t oj = 0; oj < order.size(); ++oj)
+    for (std::size_t oi = oj + 1; oi < order.size(); ++oi) {
+      // i after j in input order, so that the message names the later grain's line
+      std::size_t i = order[oj], j = order[oi];
+      if (lower(solids[j]) > upper(solids[i])) break;
+      if (j < i) std::swap(i, j);
       const Solid3 &a = solids[i], &b = solids[j];
       double depth = 0;  // how far the two interpenetrate [m]
       if (a.radius > 0 && b.radius > 0) {
@@ -214,13 +265,12 @@ void check_no_overlap_3d(const io::Config& cfg, const std::vector<Solid3>& solid
       const double smaller = std::min(size(a), size(b));
       if (depth > packing::kOverlapTolerance * smaller)
         throw InputError(
-            cfg.source_path, cfg.grains[j].line, fmt::format("grains[{}]", j),
+            cfg.source_path, cfg.grains[b.grain].line, fmt::format("grains[{}]", b.grain),
             fmt::format("grains that touch but do not overlap (up to {:g} of the smaller one's "
-                        "diameter or side): grains[{}] (line {}) overlaps grains[{}] (line {}) by "
-                        "{:.6g} m = {:.3g} of the smaller size (their common volume would be "
-                        "counted twice in the volume and Phi)",
-                        packing::kOverlapTolerance, j, cfg.grains[j].line, i, cfg.grains[i].line,
-                        depth, depth / smaller));
+                        "diameter or side): {} overlaps {} by {:.6g} m = {:.3g} of the smaller "
+                        "size (their common volume would be counted twice in the volume and Phi)",
+                        packing::kOverlapTolerance, describe(b), describe(a), depth,
+                        depth / smaller));
     }
 }
 
@@ -274,7 +324,7 @@ mpm::Model<Dim> build_model(const io::Config& cfg) {
         if (g.seeding == "polar")
           seeds = points::seed_disk_polar(center, g.radius, h / g.points_per_cell);
       } else {
-        solids3d.push_back({center, center, g.radius});
+        solids3d.push_back({center, center, g.radius, -1, i});
       }
       if (g.seeding != "polar")
         seeds = points::seed_ball<Dim>(model.grid.origin(), h, g.points_per_cell, center, g.radius);
@@ -284,10 +334,10 @@ mpm::Model<Dim> build_model(const io::Config& cfg) {
       if constexpr (Dim == 2)
         outlines.shapes.push_back({lo[0], lo[1], hi[0], hi[1], 0.0});
       else
-        solids3d.push_back({lo, hi, 0.0});
+        solids3d.push_back({lo, hi, 0.0, -1, i});
       seeds = points::seed_box<Dim>(model.grid.origin(), h, g.points_per_cell, lo, hi);
-    } else if (g.shape == "packing" && Dim == 2) {
-      if constexpr (Dim == 2) add_packing_grains(model, cfg, i, material, outlines);
+    } else if (g.shape == "packing") {
+      add_packing_grains<Dim>(model, cfg, i, material, outlines, solids3d);
       continue;
     } else {
       throw InputError(cfg.source_path, g.line, fmt::format("grains[{}].shape", i),

@@ -78,24 +78,24 @@ Schema build_schema() {
             .defaults("its defaults")},
        ""});
 
-  s.add_table(
-      &Config::simulation,
-      "Global settings. `dimension = 2` is plane strain (grains are disks, rectangles or "
-      "packings); `dimension = 3` is 3D (grains are spheres and boxes; docs/three_d.md lists "
-      "what 3D does not have yet: packings, `[output] grains`, the coverage columns).",
-      {KeySpec::string("name", &SimulationSection::name,
-                       "run name used in output file names (letters, digits, `_ - .`)")
-           .nonempty()
-           .default_of_member(),
-       KeySpec::integer("dimension", &SimulationSection::dimension, "",
-                        "spatial dimension (2 = plane strain, 3 = 3D)")
-           .at_least(2)
-           .at_most(3)
-           .default_of_member(),
-       KeySpec::integer("threads", &SimulationSection::threads, "",
-                        "OpenMP threads, 0 = OpenMP default")
-           .at_least(0)
-           .default_of_member()});
+  s.add_table(&Config::simulation,
+              "Global settings. `dimension = 2` is plane strain (grains are disks, rectangles or "
+              "packings of disks); `dimension = 3` is 3D (grains are spheres, boxes or packings of "
+              "spheres; docs/three_d.md lists what 3D does not have yet: `[output] grains`, the "
+              "coverage columns).",
+              {KeySpec::string("name", &SimulationSection::name,
+                               "run name used in output file names (letters, digits, `_ - .`)")
+                   .nonempty()
+                   .default_of_member(),
+               KeySpec::integer("dimension", &SimulationSection::dimension, "",
+                                "spatial dimension (2 = plane strain, 3 = 3D)")
+                   .at_least(2)
+                   .at_most(3)
+                   .default_of_member(),
+               KeySpec::integer("threads", &SimulationSection::threads, "",
+                                "OpenMP threads, 0 = OpenMP default")
+                   .at_least(0)
+                   .default_of_member()});
 
   s.add_table(
       &Config::grid,
@@ -132,8 +132,9 @@ Schema build_schema() {
       &Config::grains,
       "One grain, a body seeded with material points, or a packing of grains read from a file. "
       "`disk` (2D) and `sphere` (3D) need `center` and `radius`; `rectangle` (2D) and `box` (3D) "
-      "need `min_corner` < `max_corner`; `packing` (2D) needs `file` (relative to the input "
-      "file's folder, must exist). Keys of other shapes are rejected. A grain must lie inside "
+      "need `min_corner` < `max_corner`; `packing` needs `file` (relative to the input "
+      "file's folder, must exist): disks in 2D, spheres in 3D (`# dimension = 3` files). Keys of "
+      "other shapes are rejected. A grain must lie inside "
       "the grid with at least one cell of margin on every side (ghost nodes). A sphere is "
       "seeded on the lattice, its points' volumes scaled to the exact 4/3 pi r^3.",
       {KeySpec::string("shape", &GrainSection::shape, "geometry of the grain")
@@ -161,13 +162,15 @@ Schema build_schema() {
            .at_least(1)
            .at_most(8)
            .default_of_member(),
-       KeySpec::string("seeding", &GrainSection::seeding,
-                       "where the points go: `lattice` (grid-aligned sites, spacing h / "
-                       "points_per_cell) or `polar` (disks and packings only: concentric rings of "
-                       "that spacing, outermost point domains tangent to the circle, "
-                       "docs/contact.md)")
+       KeySpec::string(
+           "seeding", &GrainSection::seeding,
+           "where the points go: `lattice` (grid-aligned sites, spacing h / "
+           "points_per_cell) or `polar` (2D disks and packings only: concentric rings of "
+           "that spacing, outermost point domains tangent to the circle, "
+           "docs/contact.md)")
            .one_of({"lattice", "polar"})
-           .defaults("polar for disk and packing, lattice for rectangle, sphere and box"),
+           .defaults(
+               "polar for disk and 2D packing, lattice for rectangle, sphere, box and 3D packing"),
        KeySpec::subtable("initial", &GrainSection::initial, "initial velocity field")
            .defaults("at rest")});
 

@@ -168,11 +168,13 @@ class ConfigReader {
       g.line = r.line();
       r.fill(g);
       check_shape_dimension(r, g.shape);
-      const bool lattice_only = g.shape == "rectangle" || g.shape == "sphere" || g.shape == "box";
+      const bool lattice_only = g.shape == "rectangle" || g.shape == "sphere" || g.shape == "box" ||
+                                (g.shape == "packing" && dim_ == 3);
       if (g.seeding.empty()) g.seeding = lattice_only ? "lattice" : "polar";
       if (lattice_only && g.seeding == "polar")
         r.fail(&GrainSection::seeding,
-               fmt::format("polar seeding is for disks and packings, not for shape \"{}\"{}",
+               fmt::format("polar seeding is for disks and packings of disks, not for shape "
+                           "\"{}\"{}",
                            g.shape, dim_ == 3 ? " (3D grains are seeded on the lattice)" : ""));
       if (std::find(names.begin(), names.end(), g.material) == names.end()) {
         std::string msg =
@@ -242,25 +244,19 @@ class ConfigReader {
     return path.string();
   }
 
-  /// disk, rectangle and packing are 2D shapes, sphere and box 3D ones.
+  /// disk and rectangle are 2D shapes, sphere and box 3D ones; packing is either (its file says).
   void check_shape_dimension(const TableReader& r, const std::string& shape) const {
     static const std::map<std::string, std::pair<std::size_t, std::string>> shapes = {
         {"disk", {2, "sphere"}},
         {"rectangle", {2, "box"}},
-        {"packing", {2, ""}},
         {"sphere", {3, "disk"}},
         {"box", {3, "rectangle"}}};
     const auto it = shapes.find(shape);
     if (it == shapes.end() || it->second.first == dim_) return;
     const auto& [dim, other] = it->second;
-    r.fail(&GrainSection::shape,
-           other.empty()
-               ? fmt::format("shape \"{}\" is {}D only, but [simulation] dimension = {} (3D "
-                             "packings are not read yet: give each sphere as a [[grains]] entry)",
-                             shape, dim, dim_)
-               : fmt::format("shape \"{}\" is {}D only, but [simulation] dimension = {}: use "
-                             "shape = \"{}\"",
-                             shape, dim, dim_, other));
+    r.fail(&GrainSection::shape, fmt::format("shape \"{}\" is {}D only, but [simulation] "
+                                             "dimension = {}: use shape = \"{}\"",
+                                             shape, dim, dim_, other));
   }
 
   /// Each shape has its keys: required for it, rejected for the others.

@@ -10,20 +10,22 @@
 namespace mpmcd::packing {
 
 /// Points of all grains, grouped by grain: grain g owns points [offset[g], offset[g + 1]).
+template <int Dim>
 struct SeededPacking {
-  std::vector<Vec<2>> x;            ///< point positions [m]
-  std::vector<double> volume;       ///< point areas (volume per unit thickness) [m^2]
+  std::vector<Vec<Dim>> x;     ///< point positions [m]
+  std::vector<double> volume;  ///< point volumes (2D: areas, volume per unit thickness) [m^Dim]
   std::vector<std::int64_t> grain;  ///< index of the owning disk in Packing::disks [-]
   std::vector<std::size_t> offset;  ///< size disks + 1; points of grain g: offset[g]..[g + 1]
 };
 
-/// Seeds every disk with mpmcd::points::seed_ball<2> (sites origin + (i + 1/2) h / ppc strictly
-/// inside the disk). A site inside two disks (DEM overlaps) goes to the disk with the smaller
-/// |x - c| / r (ties: lower index); each grain's point areas are then rescaled so that they sum
-/// to its disk area pi r^2. `grid_origin` [m], `cell_size` h [m], `points_per_cell` ppc [-].
-/// Throws InputError ("points_per_cell") when a disk would get no point, ("dimension") for a 3D
-/// packing.
-SeededPacking seed_packing(const Packing& packing, const Vec<2>& grid_origin, double cell_size,
-                           int points_per_cell);
+/// Seeds every disk (sphere) with mpmcd::points::seed_ball<Dim> (sites origin + (i + 1/2) h / ppc
+/// strictly inside it). A site inside two of them (DEM overlaps) goes to the one with the smaller
+/// |x - c| / r (ties: lower index); each grain's point volumes are then rescaled so that they sum
+/// to its exact measure, pi r^2 or 4/3 pi r^3 (docs/packing.md §8, eq. 12-13). `grid_origin` [m],
+/// `cell_size` h [m], `points_per_cell` ppc [-]. Throws InputError ("points_per_cell") when a
+/// grain would get no point, ("dimension") when the packing's dimension is not Dim.
+template <int Dim>
+SeededPacking<Dim> seed_packing(const Packing& packing, const Vec<Dim>& grid_origin,
+                                double cell_size, int points_per_cell);
 
 }  // namespace mpmcd::packing

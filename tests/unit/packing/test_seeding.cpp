@@ -15,7 +15,7 @@ using namespace mpmcd::packing;
 
 namespace {
 
-void expect_valid_seeding(const Packing& pk, const SeededPacking& s) {
+void expect_valid_seeding(const Packing& pk, const SeededPacking<2>& s) {
   ASSERT_EQ(s.offset.size(), pk.disks.size() + 1);
   ASSERT_EQ(s.x.size(), s.volume.size());
   ASSERT_EQ(s.x.size(), s.grain.size());

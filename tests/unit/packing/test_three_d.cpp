@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
+#include <set>
 #include <string>
 
 #include <unistd.h>
@@ -282,8 +285,8 @@ TEST(ThreeDPacking, PackInputAcceptsDimension3AndNamesBadKeys) {
   refused(head + "aspect_ratio = 1.0\nfriction = 0.2\n", "key 'packing.friction': 0 in 3D");
 }
 
-// `mpmcd pack` of a 3D input writes the CSV and the VTU and prints the 3D box; seed_packing (2D
-// grains) refuses a 3D packing.
+// `mpmcd pack` of a 3D input writes the CSV and the VTU and prints the 3D box; seed_packing of
+// 2D grains refuses a 3D packing, and 3D grains get each its sphere's exact volume.
 TEST(ThreeDPacking, PackCommandWrites3DFiles) {
   const auto input = scratch("pack3d.toml");
   const auto folder = scratch("out3d");
@@ -303,6 +306,34 @@ TEST(ThreeDPacking, PackCommandWrites3DFiles) {
   EXPECT_EQ(pk.disks.size(), 60u);
   EXPECT_EQ(pk.zmax, 0.005);
   EXPECT_NEAR(packing_fraction(pk), 0.45, 1e-9);
-  EXPECT_THROW(seed_packing(pk, mpmcd::Vec<2>::Zero(), 1e-4, 2), mpmcd::InputError);
+  EXPECT_THROW(seed_packing<2>(pk, mpmcd::Vec<2>::Zero(), 1e-4, 2), mpmcd::InputError);
+  // 3D seeding at h = 0.25 mm (about d/4), 2 points per cell axis: each sphere's points lie inside
+  // it, no lattice site is seeded twice, and the volumes sum to 4/3 pi r^3 per sphere.
+  const double h = 0.25e-3, s = h / 2;
+  const auto seeded = seed_packing<3>(pk, mpmcd::Vec<3>(-h, -h, -h), h, 2);
+  ASSERT_EQ(seeded.offset.size(), pk.disks.size() + 1);
+  ASSERT_EQ(seeded.offset.back(), seeded.x.size());
+  std::set<std::array<long long, 3>> sites;
+  double total = 0, exact = 0;
+  for (std::size_t g = 0; g < pk.disks.size(); ++g) {
+    const auto& d = pk.disks[g];
+    const mpmcd::Vec<3> c(d.x, d.y, d.z);
+    double volume = 0;
+    ASSERT_LT(seeded.offset[g], seeded.offset[g + 1]) << "sphere " << d.id << " has no point";
+    for (std::size_t k = seeded.offset[g]; k < seeded.offset[g + 1]; ++k) {
+      EXPECT_LT((seeded.x[k] - c).norm(), d.radius);
+      volume += seeded.volume[k];
+      std::array<long long, 3> site{};
+      for (int a = 0; a < 3; ++a) site[a] = std::llround((seeded.x[k][a] + h) / s - 0.5);
+      EXPECT_TRUE(sites.insert(site).second) << "site seeded twice";
+    }
+    const double v = 4.0 / 3.0 * std::numbers::pi * std::pow(d.radius, 3);
+    EXPECT_NEAR(volume, v, 1e-12 * v);
+    total += volume;
+    exact += v;
+  }
+  // the lattice count is the volume over s^3 within a few percent (points per sphere ~ 270)
+  EXPECT_NEAR(static_cast<double>(seeded.x.size()) * s * s * s / exact, 1.0, 0.03);
+  EXPECT_NEAR(total, exact, 1e-12 * exact);
   fs::remove_all(scratch("").parent_path());
 }

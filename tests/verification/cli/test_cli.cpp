@@ -209,7 +209,7 @@ TEST(Cli, PackInThreeDimensionsAndItsBadKeys) {
   EXPECT_NE(text.find("# dimension = 3\n"), std::string::npos) << text.substr(0, 200);
   EXPECT_NE(text.find("\nid,x,y,z,radius\n"), std::string::npos) << text.substr(0, 200);
   // A 2D run given the sphere packing (its CSV, or its input to generate) is refused, naming the
-  // dimension (spheres are not yet read as grains).
+  // dimension.
   for (const std::string file : {"out/packing.csv", "pack.toml"}) {
     const fs::path in = write_input(
         dir, "[[grains]]\nshape = \"packing\"\nfile = \"" + file + "\"\nmaterial = \"gel\"\n",

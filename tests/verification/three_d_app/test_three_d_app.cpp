@@ -3,6 +3,7 @@
 // has the exact initial Φ and, stopped half way and restarted from its checkpoint, ends with the
 // same bytes in every output; 3D inputs with the wrong number of components, or 2D-only shapes
 // and keys, are refused with exit 2 and a message naming the file, the key and what was expected.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -211,6 +212,128 @@ TEST(ThreeDApp, BadInputsAreRefusedWithExitTwo) {
     EXPECT_NE(r.output.find(input.filename().string()), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("'" + c.key + "'"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(c.says), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / ("out_" + c.name))) << c.name << ": wrote outputs";
+  }
+}
+
+// A 3D packing read as grains (`shape = "packing"` in a `dimension = 3` run): the spheres of a
+// DEM packing (`mpmcd pack`, 20 spheres, Phi0 = 0.40) in a box of six walls, the top one moving
+// down. Step 0 has the packing's Phi (sum of 4/3 pi r^3 over the box volume, from the CSV) to
+// round-off and the mass rho sum 4/3 pi r^3; giving the packing input (.toml, generated when the
+// run starts) instead of its CSV writes the same CSV bytes; the spheres are squeezed (Phi rises,
+// the top wall pushes). A 2D packing in a 3D run, polar seeding, and a [[grains]] sphere
+// overlapping a packing's sphere are refused with exit 2, naming the file, the key and the sphere.
+TEST(ThreeDApp, SpherePackingIsReadAsGrains) {
+  const fs::path dir = scratch("packing");
+  std::ofstream(dir / "pack.toml")
+      << "[packing]\ndimension = 3\ncount = 20\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+         "target_phi = 0.40\naspect_ratio = 1.0\nseed = 4\n[output]\nfolder = \""
+      << dir.string() << "\"\nname = \"packing\"\nvtu = false\n";
+  const auto packed = run("pack -q --overwrite " + (dir / "pack.toml").string());
+  ASSERT_EQ(packed.code, 0) << packed.output;
+  // The box and the spheres from the CSV.
+  std::ifstream csv_in(dir / "packing.csv");
+  std::string line;
+  std::vector<double> box;
+  double volume = 0;
+  int spheres = 0;
+  while (std::getline(csv_in, line)) {
+    if (line.rfind("# box = ", 0) == 0) {
+      std::stringstream ss(line.substr(8));
+      for (double v; ss >> v;) box.push_back(v);
+    } else if (!line.empty() && line[0] != '#' && line[0] != 'i') {
+      std::stringstream ss(line);
+      std::vector<double> f;
+      for (std::string s; std::getline(ss, s, ',');) f.push_back(std::stod(s));
+      ASSERT_EQ(f.size(), 5u) << line;
+      volume += 4.0 / 3.0 * std::numbers::pi * std::pow(f[4], 3);
+      ++spheres;
+    }
+  }
+  ASSERT_EQ(box.size(), 6u);
+  ASSERT_EQ(spheres, 20);
+  const double L = box[3] - box[0];
+  const double extent = std::ceil((L + 1e-3) / 0.25e-3) * 0.25e-3;  // whole cells, margin >= h
+  const auto num = [](double v) { return fmt::format("{:.17g}", v); };
+  const auto wall = [&](const std::string& name, double px, double py, double pz,
+                        const std::string& normal, const std::string& extra) {
+    return "[[walls]]\nname = \"" + name + "\"\npoint = [" + num(px) + ", " + num(py) + ", " +
+           num(pz) + "]\nnormal = " + normal + "\n" + extra;
+  };
+  const auto input = [&](const std::string& name, const std::string& grains) {
+    return write_input(
+        dir, name,
+        "[simulation]\nname = \"" + name +
+            "\"\ndimension = 3\n[grid]\norigin = [-0.5e-3, "
+            "-0.5e-3, -0.5e-3]\nextent = [" +
+            num(extent) + ", " + num(extent) + ", " + num(extent) +
+            "]\ncell_size = 0.25e-3\n[[materials]]\nname = \"gel\"\nlaw = "
+            "\"neo_hookean\"\ndensity = 990.0\nlambda = 3e6\nmu = 1.5e6\n" +
+            grains + wall("left", 0, 0, 0, "[1.0, 0.0, 0.0]", "") +
+            wall("right", L, 0, 0, "[-1.0, 0.0, 0.0]", "") +
+            wall("bottom", 0, 0, 0, "[0.0, 1.0, 0.0]", "") +
+            wall("top", 0, L, 0, "[0.0, -1.0, 0.0]", "velocity = [0.0, -10.0, 0.0]\n") +
+            wall("front", 0, 0, 0, "[0.0, 0.0, 1.0]", "") +
+            wall("back", 0, 0, L, "[0.0, 0.0, -1.0]", "") +
+            "[contact]\nfriction = 0.0\ndelassus = \"grain\"\n"
+            "[time]\ndt = 2e-6\nend_time = 4e-5\n[output]\nvtu = false\n");
+  };
+  const std::string from_csv =
+      "[[grains]]\nshape = \"packing\"\nfile = \"packing.csv\"\nmaterial = \"gel\"\n"
+      "points_per_cell = 1\n";
+  const fs::path a = input("csv", from_csv);
+  const auto ra = run("run -q -t 2 -o " + (dir / "out_csv").string() + " " + a.string());
+  ASSERT_EQ(ra.code, 0) << ra.output;
+  auto cols = read_csv(dir / "out_csv" / "csv.csv");
+  ASSERT_GE(cols["phi"].size(), 21u);
+  const double phi0 = volume / (L * L * L);
+  EXPECT_NEAR(cols["phi"][0], phi0, 1e-12 * phi0);
+  EXPECT_NEAR(cols["phi"][0], 0.40, 1e-9);
+  EXPECT_NEAR(cols["mass"][0], 990.0 * volume, 1e-12 * 990.0 * volume);
+  EXPECT_GT(cols["phi"].back(), cols["phi"][0] * 1.05);  // the top wall moved 0.4 mm of 2.7 mm
+  EXPECT_GT(cols["wall_top_fy"].back(), 0.0) << "the top wall pushes the spheres down";
+  std::printf(
+      "3D packing: 20 spheres, Phi0 %.12f (CSV %.12f), after %zu steps Phi %.6f, top "
+      "force %.4g N, Z %.3f\n",
+      cols["phi"][0], phi0, cols["phi"].size() - 1, cols["phi"].back(), cols["wall_top_fy"].back(),
+      cols["Z"].back());
+  // The packing input generated at run start gives the same run.
+  std::string from_toml = from_csv;
+  from_toml.replace(from_toml.find("packing.csv"), 11, "pack.toml");
+  const fs::path b = input("csv", from_toml);
+  const auto rb = run("run -q -t 2 -o " + (dir / "out_toml").string() + " " + b.string());
+  ASSERT_EQ(rb.code, 0) << rb.output;
+  EXPECT_EQ(read_file(dir / "out_csv" / "csv.csv"), read_file(dir / "out_toml" / "csv.csv"));
+
+  // Refused: a 2D packing, polar seeding, a sphere overlapping a packing's sphere.
+  std::ofstream(dir / "disks.csv") << "id,x,y,radius\n0,0.001,0.001,0.0004\n";
+  std::stringstream first([&] {
+    std::ifstream in(dir / "packing.csv");
+    std::string l;
+    while (std::getline(in, l))
+      if (!l.empty() && l[0] != '#' && l[0] != 'i') return l;
+    return std::string();
+  }());
+  std::vector<double> s0;
+  for (std::string f; std::getline(first, f, ',');) s0.push_back(std::stod(f));
+  struct Case {
+    std::string name, grains, key, says;
+  };
+  const std::vector<Case> cases = {
+      {"disks", "[[grains]]\nshape = \"packing\"\nfile = \"disks.csv\"\nmaterial = \"gel\"\n",
+       "dimension", "a 3D run (grains[0]"},
+      {"polar", from_csv + "seeding = \"polar\"\n", "grains[0].seeding",
+       "3D grains are seeded on the lattice"},
+      {"overlap",
+       from_csv + "[[grains]]\nshape = \"sphere\"\nmaterial = \"gel\"\ncenter = [" + num(s0[1]) +
+           ", " + num(s0[2]) + ", " + num(s0[3]) + "]\nradius = 0.2e-3\n",
+       "grains[1]", fmt::format("overlaps sphere id {} of", static_cast<int>(s0[0]))}};
+  for (const auto& c : cases) {
+    const fs::path in = input("bad_" + c.name, c.grains);
+    const auto r = run("run -q -o " + (dir / ("out_" + c.name)).string() + " " + in.string());
+    EXPECT_EQ(r.code, 2) << c.name << ": " << r.output;
+    EXPECT_NE(r.output.find("'" + c.key + "'"), std::string::npos) << c.name << ": " << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.name << ": " << r.output;
     EXPECT_FALSE(fs::exists(dir / ("out_" + c.name))) << c.name << ": wrote outputs";
   }
 }
