@@ -24,9 +24,10 @@ plane misses a thin domain; a grain's sections are merged into one filled outlin
 boundary (GrainShape). Walls cut by the plane are drawn as lines. --dots: the slab's points.
 
 view: the grains' outer points (fewer neighbours within 1.5 spacings than inside the grain, or
-an off-centre neighbourhood) as discs seen from --elev, --azim (degrees; y is up), shaded by their
-outward normal (Lambert) and fading with depth, painted far to near; the box of the walls (six
-walls with normals +-x, +-y, +-z) as its twelve edges.
+an off-centre neighbourhood, in the first snapshot of the series) as discs seen from --elev,
+--azim (degrees; y is up), shaded by their outward normal (Lambert) and fading with depth,
+painted far to near; the box of the walls (six walls with normals +-x, +-y, +-z) as its twelve
+edges.
 
 --field grain: each grain in one colour of a palette of --colours (default 8) in which grains
 whose points come within one grid cell (plus their domains) or that are in contact (the
@@ -115,21 +116,25 @@ def sections(pts, edges, axis, c):
     return out, cut
 
 
-def outer_points(pts, grain, spacing):
+def outer_points(pts, grain, spacing, reference=None):
     """(n,) bool: the points on the surface of their grain, and (n, 3) their outward normals (unit).
     A point is outer when it has fewer neighbours of its grain within 1.5 spacings than 95 % of the
-    grain's most, or when the mean offset of those neighbours is over 0.15 spacings (one-sided)."""
+    grain's most, or when the mean offset of those neighbours is over 0.15 spacings (one-sided).
+    The neighbours are found in `reference` (the same points at the first snapshot, where the
+    lattice is regular: a squeezed grain's inner points would lose neighbours beyond 1.5 spacings)
+    when given, the normal is minus their mean offset now."""
+    ref = pts if reference is None else reference
     outer = np.zeros(len(pts), bool)
     normal = np.zeros_like(pts)
     for g in np.unique(grain):
         idx = np.flatnonzero(grain == g)
-        x = pts[idx]
+        x0, x = ref[idx], pts[idx]
         s = np.median(spacing[idx])
-        nb = cKDTree(x).query_ball_point(x, 1.5 * s)
+        nb = cKDTree(x0).query_ball_point(x0, 1.5 * s)
         count = np.array([len(n) - 1 for n in nb])
-        offset = np.array([x[n].mean(axis=0) for n in nb]) - x
-        out = (count < 0.95 * count.max()) | (np.linalg.norm(offset, axis=1) > 0.15 * s)
-        nrm = -offset
+        offset0 = np.array([x0[n].mean(axis=0) for n in nb]) - x0
+        out = (count < 0.95 * count.max()) | (np.linalg.norm(offset0, axis=1) > 0.15 * s)
+        nrm = x - np.array([x[n].mean(axis=0) for n in nb])
         radial = x - x.mean(axis=0)
         weak = np.linalg.norm(nrm, axis=1) < 0.05 * s
         nrm[weak] = radial[weak]
@@ -519,6 +524,7 @@ def run(args):
     out = args.output or os.path.join(args.folder, "snapshots")
     os.makedirs(out, exist_ok=True)
     cell = float(cfg.get("grid", {}).get("cell_size", 0.0))
+    first = None  # the first snapshot (positions, arrays): the reference of the outer points
     for label, k, asked in choose(args, cols, series):
         t, vtu = series[k]
         pts, arr = read_snapshot(vtu)
@@ -531,7 +537,10 @@ def run(args):
         title = None if args.no_title else state
         walls = walls_at(cfg, cols, t)
         spacing = np.cbrt(arr["volume"])
-        outer = outer_points(pts, grain, spacing)
+        if first is None:
+            first = read_snapshot(series[0][1])
+        same = len(first[0]) == len(pts) and np.array_equal(first[1]["grain"], arr["grain"])
+        outer = outer_points(pts, grain, spacing, first[0] if same else None)
         colours = None
         value_range = args.range
         if args.field == "grain":

@@ -236,6 +236,13 @@ class RealRun(unittest.TestCase):
             self.assertGreater(r[o].min(), r[~o].max() - 0.5 * R)  # no deep point is outer
             self.assertGreater(o.sum(), 0.4 * len(o))
             self.assertGreater(np.min(np.sum(normal[grain == g][o] * radial[o], axis=1)), 0.3)
+        # The last snapshot, squeezed: with the first as reference, the same points are outer.
+        last, arr2 = self.snapshot(2)
+        outer2, normal2 = p3.outer_points(last, grain, np.cbrt(arr2["volume"]), pts)
+        print(f"last snapshot: {outer2.sum()} outer (first {outer.sum()}), normals . first's >= "
+              f"{np.min(np.sum(normal2[outer] * normal[outer], axis=1)):.3f}")
+        np.testing.assert_array_equal(outer2, outer)
+        self.assertGreater(np.min(np.sum(normal2[outer] * normal[outer], axis=1)), 0.8)
 
     def test_walls_follow_the_csv(self):
         folder = real_run()
