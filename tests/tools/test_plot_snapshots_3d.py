@@ -6,7 +6,8 @@ Usage: test_plot_snapshots_3d.py [workdir [mpmcd-binary]]   (or the binary in $M
 - the section of a domain (a parallelepiped) by a plane: a cube turned about the plane's normal
   gives the turned square, turned about an in-plane axis a rectangle 1/cos(angle) wide;
 - on a real 3D run (`mpmcd run`, five spheres in a box of six walls, the top wall squeezing
-  them, about 1 s): the points in each slab are those a numpy count gives, at t = 0 one lattice layer;
+  them, about 1 s): the points in each slab are those a numpy count gives, at t = 0 one lattice
+  layer;
   a grain's outline covers its domains' sections (which tile at t = 0) and is centred on the
   sphere; the outer points are the sphere's outer shell, their normals radial; grains that touch
   (points of two grains within 1.2 spacings) never share a colour, also with a palette of 2;
@@ -40,6 +41,9 @@ R = 0.6e-3  # sphere radius [m]
 # 0.01 mm above the fifth, squeezes it by 0.14 mm in 3e-4 s (25 steps, under a second).
 CENTRES = [(1.4e-3, 1.4e-3, 1.4e-3), (2.6e-3, 1.4e-3, 1.4e-3), (1.4e-3, 1.4e-3, 2.6e-3),
            (2.6e-3, 1.4e-3, 2.6e-3), (2.0e-3, 2.25e-3, 2.0e-3)]
+WALLS = (("left", (8e-4, 0, 0), (1.0, 0, 0)), ("right", (3.2e-3, 0, 0), (-1.0, 0, 0)),
+         ("bottom", (0, 8e-4, 0), (0, 1.0, 0)), ("top", (0, 2.86e-3, 0), (0, -1.0, 0)),
+         ("front", (0, 0, 8e-4), (0, 0, 1.0)), ("back", (0, 0, 3.2e-3), (0, 0, -1.0)))
 INPUT = """[simulation]
 name = "mini"
 dimension = 3
@@ -63,9 +67,7 @@ radius = {R}
 name = "{name}"
 point = [{p[0]}, {p[1]}, {p[2]}]
 normal = [{n[0]}, {n[1]}, {n[2]}]
-""" for name, p, n in (("left", (8e-4, 0, 0), (1.0, 0, 0)), ("right", (3.2e-3, 0, 0), (-1.0, 0, 0)),
-                       ("bottom", (0, 8e-4, 0), (0, 1.0, 0)), ("top", (0, 2.86e-3, 0), (0, -1.0, 0)),
-                       ("front", (0, 0, 8e-4), (0, 0, 1.0)), ("back", (0, 0, 3.2e-3), (0, 0, -1.0)))) + """
+""" for name, p, n in WALLS) + """
 [loading]
 [[loading.stages]]
 name = "squeeze"
@@ -280,8 +282,8 @@ class RealRun(unittest.TestCase):
             fig, drawn = p3.draw_slices(pts, arr, field, planes, 1.9e-4, None,
                                         value_range=(lo, hi))
             self.assertEqual(len(fig.axes), 3)  # two panels and the colour bar
-            self.assertEqual([n for _, _, n, _ in drawn],
-                             [np.count_nonzero(np.abs(pts[:, a] - c) <= 0.95e-4) for a, c in planes])
+            counts = [np.count_nonzero(np.abs(pts[:, a] - c) <= 0.95e-4) for a, c in planes]
+            self.assertEqual([n for _, _, n, _ in drawn], counts)
             p3.plt.close(fig)
             fig, n = p3.draw_view(pts, arr, field, None, value_range=(lo, hi))
             print(f"{field}: scale [{lo:.4g}, {hi:.4g}], view of {n} points")
