@@ -66,8 +66,9 @@ def fail(msg):
     sys.exit(2)
 
 
-def read_run(folder):
-    """(input dict, CSV columns dict, [(time, vtu path)]) of an mpmcd output folder."""
+def read_run(folder, required=("time", "phi", "eps"), optional=()):
+    """(input dict, CSV columns dict, [(time, vtu path)]) of an mpmcd output folder: the CSV's
+    `required` columns (refused when missing) and those of `optional` it has, as arrays."""
     path = os.path.join(folder, "input.toml")
     if not os.path.isfile(path):
         raise InputError(f"{path}: no input copy (expected the output folder of `mpmcd run`)")
@@ -82,19 +83,22 @@ def read_run(folder):
         raise InputError(f"{csv_path}: no CSV time series")
     with open(csv_path, newline="") as f:
         rows = list(csv.DictReader(f))
-    missing = [k for k in ("time", "phi", "eps") if not rows or k not in rows[0]]
+    missing = [k for k in required if not rows or k not in rows[0]]
+    box = " (the walls must form a box)" if "phi" in missing else ""
     if missing:
-        raise InputError(f"{csv_path}: expected the columns time, phi, eps (the walls must form a "
-                         f"box); missing {', '.join(missing)}")
+        raise InputError(f"{csv_path}: expected the columns {', '.join(required)}{box}; missing "
+                         f"{', '.join(missing)}")
+    keys = list(required) + [k for k in optional if k in rows[0] and k not in required]
     try:
-        cols = {k: np.array([float(r[k]) for r in rows]) for k in ("time", "phi", "eps")}
+        cols = {k: np.array([float(r[k]) for r in rows]) for k in keys}
     except (TypeError, ValueError):
-        raise InputError(f"{csv_path}: expected numbers in the columns time, phi, eps")
+        raise InputError(f"{csv_path}: expected numbers in the columns {', '.join(keys)}")
     pvd = os.path.join(folder, name + ".pvd")
     if not os.path.isfile(pvd):
         raise InputError(f"{pvd}: no VTU series (set [output] vtu = true)")
-    series = [(float(t), os.path.join(folder, file)) for t, file in
-              re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', open(pvd).read())]
+    with open(pvd) as f:
+        series = [(float(t), os.path.join(folder, file)) for t, file in
+                  re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', f.read())]
     if not series:
         raise InputError(f"{pvd}: expected <DataSet timestep=... file=...> entries, found none")
     return cfg, cols, series
@@ -171,22 +175,26 @@ def domains(xy, arr, first):
 
 class GrainShape:
     """The region of one grain: the union of its points' domains with the slivers between them
-    closed. `vertices` (m, 2), `owner` (m,) the point (row of the grain's corners) each vertex
-    belongs to, `triangles` (k, 3) counter-clockwise, covering the region, `loops` its boundary
-    (outer loops counter-clockwise, holes clockwise), each (l, 2).
+    closed. `corners` (n, k, 2): each domain a convex polygon of k vertices in order (the 2D
+    parallelograms, k = 4; the 3D sections of tools/plot_snapshots_3d.py, padded to k = 6 by
+    repeating a vertex). `vertices` (m, 2), `owner` (m,) the point (row of the grain's corners)
+    each vertex belongs to, `triangles` (k, 3) counter-clockwise, covering the region, `loops` its
+    boundary (outer loops counter-clockwise, holes clockwise), each (l, 2).
 
     The vertices are the domains' corners and centres; a triangle of their Delaunay triangulation
-    is kept when its longest edge is at most the longest diagonal of the domains of its vertices
+    is kept when its longest edge is at most the longest diagonal (the largest distance between two
+    corners) of the domains of its vertices
     (an alpha shape with the local point spacing as alpha): triangles inside a domain or bridging
     the sliver between neighbouring domains are kept, those spanning a concavity wider than a
     domain are not."""
 
     def __init__(self, corners):
-        n = len(corners)
+        n, k = corners.shape[:2]
         pts = np.concatenate([corners.reshape(-1, 2), corners.mean(axis=1)])
-        owner = np.concatenate([np.repeat(np.arange(n), 4), np.arange(n)])
-        diag = np.maximum(np.linalg.norm(corners[:, 2] - corners[:, 0], axis=1),
-                          np.linalg.norm(corners[:, 3] - corners[:, 1], axis=1))
+        owner = np.concatenate([np.repeat(np.arange(n), k), np.arange(n)])
+        # (A parallelogram's longest vertex distance is a diagonal: the same as before for k = 4.)
+        diag = np.linalg.norm(corners[:, :, None, :] - corners[:, None, :, :],
+                              axis=3).max(axis=(1, 2))
         # Corners shared by neighbouring domains become one vertex (its largest diagonal).
         tol = 1e-9 * max(np.ptp(pts, axis=0).max(), 1e-300)
         _, first, inverse = np.unique(np.round(pts / tol), axis=0, return_index=True,
@@ -201,8 +209,8 @@ class GrainShape:
             longest = np.max(np.linalg.norm(v - np.roll(v, 1, axis=1), axis=2), axis=1)
             tri = tri[longest <= (1 + 1e-9) * reach[tri].max(axis=1)]
         except (QhullError, ValueError):  # degenerate (collinear, too few points): the domains
-            quads = inverse[:4 * n].reshape(n, 4)
-            tri = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+            polys = inverse[:k * n].reshape(n, k)
+            tri = np.concatenate([polys[:, [0, j, j + 1]] for j in range(1, k - 1)])
         v = self.vertices[tri]
         cross = ((v[:, 1, 0] - v[:, 0, 0]) * (v[:, 2, 1] - v[:, 0, 1])
                  - (v[:, 1, 1] - v[:, 0, 1]) * (v[:, 2, 0] - v[:, 0, 0]))
@@ -295,6 +303,16 @@ def palette_colours(n):
     return colours[:n] if n <= len(colours) else None
 
 
+def vertex_values(shape, xy, values):
+    """A grain's per-point `values` at the vertices of its GrainShape, from its points at `xy`
+    (same units as the shape): inverse-distance weights of the 4 nearest points."""
+    k = min(4, len(xy))
+    d, j = cKDTree(xy).query(shape.vertices, k=k)
+    d, j = d.reshape(len(d), k), j.reshape(len(j), k)
+    w = 1.0 / np.maximum(d, 1e-9 * d.max()) ** 2
+    return np.sum(w * values[j], axis=1) / w.sum(axis=1)
+
+
 def grain_pressure(arr, grain, ids):
     """{grain: P [MPa]}, P = -(σxx + σyy)/2 of the volume average of the points' stresses."""
     s, vol = arr["stress"], arr["volume"]
@@ -380,21 +398,17 @@ def draw_snapshot(pts, arr, field, corners, walls=(), gap=None, contacts=(), net
             fig.colorbar(coll, **bar, label="grain pressure −(σxx + σyy)/2 [MPa]")
     else:
         values = arr["pressure"] / 1e6 if field == "point_pressure" else arr["J"]
-        xs, tris, vertex_values, offset = [], [], [], 0
+        xs, tris, at_vertices, offset = [], [], [], 0
         for g in ids:
             s, idx = shapes[g], np.flatnonzero(grain == g)
             xs.append(s.vertices)
             tris.append(s.triangles + offset)
             # The vertex's value: inverse-distance weights of its grain's 4 nearest points.
-            k = min(4, len(idx))
-            d, j = cKDTree(xy[idx]).query(s.vertices, k=k)
-            d, j = d.reshape(len(d), k), j.reshape(len(j), k)
-            w = 1.0 / np.maximum(d, 1e-9 * d.max()) ** 2
-            vertex_values.append(np.sum(w * values[idx][j], axis=1) / w.sum(axis=1))
+            at_vertices.append(vertex_values(s, xy[idx], values[idx]))
             offset += len(s.vertices)
         xs = np.concatenate(xs)
         # Interpolated linearly over the triangles (Gouraud shading).
-        coll = ax.tripcolor(xs[:, 0], xs[:, 1], np.concatenate(tris), np.concatenate(vertex_values),
+        coll = ax.tripcolor(xs[:, 0], xs[:, 1], np.concatenate(tris), np.concatenate(at_vertices),
                             shading="gouraud", cmap="viridis", vmin=vmin, vmax=vmax, zorder=1)
         coll.set_rasterized(True)  # an image inside PDF and SVG (vector Gouraud: 30 MB of SVG)
         for g in ids:
@@ -459,6 +473,9 @@ def main():
 
 def run(args):
     cfg, cols, series = read_run(args.folder)
+    if cfg.get("simulation", {}).get("dimension", 2) != 2:
+        raise InputError(f"{os.path.join(args.folder, 'input.toml')}: expected a 2D run, found "
+                         "[simulation] dimension = 3 (draw it with tools/plot_snapshots_3d.py)")
     name = cfg.get("simulation", {}).get("name", "mpmcd")
     out = args.output or os.path.join(args.folder, "snapshots")
     os.makedirs(out, exist_ok=True)

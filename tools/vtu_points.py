@@ -15,7 +15,8 @@ _TYPES = {"Float64": np.float64, "Int32": np.int32, "Int64": np.int64, "UInt8": 
 
 def read_vtu(path):
     """Returns (points (n, 3) array, dict name -> array) of an mpmcd .vtu file."""
-    raw = open(path, "rb").read()
+    with open(path, "rb") as f:
+        raw = f.read()
     start = raw.index(b'<AppendedData encoding="raw">')
     blob = raw[raw.index(b"_", start) + 1:]
     header = raw[:start].decode()
