@@ -1,6 +1,9 @@
 #pragma once
 // Small builders shared by the verification tests: a model with one material and grains.
 #include <cmath>
+#include <functional>
+#include <string>
+#include <type_traits>
 
 #include "mpmcd/materials/law.hpp"
 #include "mpmcd/mpm/model.hpp"
@@ -14,20 +17,29 @@ namespace mpmcd::test_support {
 inline constexpr double kLambda = 3e6, kMu = 1.5e6, kRho = 990.0;
 inline const double kCp = std::sqrt((kLambda + 2 * kMu) / kRho);
 
-// A 2D model on a grid [0, cells*h]^2 with one material of the given law.
-inline mpm::Model<2> make_model(double h, int cells_x, int cells_y, const std::string& law,
-                                double lambda, double mu, double rho) {
-  mpm::Model<2> m;
-  m.grid = grid::Grid<2>(Vec<2>::Zero(), h, IVec<2>(cells_x, cells_y));
-  m.add_material(materials::make_law<2>(law, {{"lambda", lambda}, {"mu", mu}}), rho);
+// A model on a grid [0, cells h] with one material of the given law.
+template <int Dim>
+mpm::Model<Dim> make_model(double h, const IVec<Dim>& cells, const std::string& law, double lambda,
+                           double mu, double rho) {
+  mpm::Model<Dim> m;
+  m.grid = grid::Grid<Dim>(Vec<Dim>::Zero(), h, cells);
+  m.add_material(materials::make_law<Dim>(law, {{"lambda", lambda}, {"mu", mu}}), rho);
   return m;
 }
 
-// Adds a rectangle grain seeded with ppc x ppc points per cell.
-inline int add_box(mpm::Model<2>& m, const Vec<2>& lo, const Vec<2>& hi, int ppc,
-                   const std::function<Vec<2>(const Vec<2>&)>& v = {}) {
+// A 2D model on a grid [0, cells*h]^2 with one material of the given law.
+inline mpm::Model<2> make_model(double h, int cells_x, int cells_y, const std::string& law,
+                                double lambda, double mu, double rho) {
+  return make_model<2>(h, IVec<2>(cells_x, cells_y), law, lambda, mu, rho);
+}
+
+// Adds a box grain [lo, hi] seeded with ppc^Dim points per cell (Dim from the model).
+template <int Dim>
+int add_box(mpm::Model<Dim>& m, const std::type_identity_t<Vec<Dim>>& lo,
+            const std::type_identity_t<Vec<Dim>>& hi, int ppc,
+            const std::type_identity_t<std::function<Vec<Dim>(const Vec<Dim>&)>>& v = {}) {
   const double h = m.grid.cell_size();
-  auto seeds = points::seed_box<2>(m.grid.origin(), h, ppc, lo, hi);
+  auto seeds = points::seed_box<Dim>(m.grid.origin(), h, ppc, lo, hi);
   return m.add_grain(seeds, 0, 0.5 * h / ppc, v);
 }
 

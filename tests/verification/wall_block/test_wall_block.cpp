@@ -9,234 +9,23 @@
 // moving left too), each against its own closed form.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <initializer_list>
 #include <tuple>
 
-#include "../../support/builders.hpp"
+#include "../../support/wall_block.hpp"
 
 using namespace mpmcd;
 
 namespace {
 
-struct BlockResult {
-  double worst_J = 0, worst_sigma = 0, force_error = 0, energy_ratio = 0;
-  // max |sigma11 - exact| / |sigma11 exact| (biaxial), / |sigma22 exact| otherwise (uniaxial
-  // stress: sigma11 = 0) [-]
-  double worst_sigma11 = 0;
-  double side_force_error = 0;  // right wall (biaxial) [-]
-  // Over every committed step: the largest |J - J_exact|, and the first s where it, or any
-  // point's sigma11 or sigma22 error relative to max(|sigma11|, |sigma22|) exact, passed 1e-3
-  // (1 if never)
-  double run_worst_J = 0, lost_at = 1.0;
-  double first_retry_at = 1.0;  // s at the start of the first step redone as half steps [-]
-  double seconds = 0;           // wall-clock time of the run [s]
-  double last_step_work = 0;    // final force x wall travel of one step / wall work [-]
-  // (elastic + kinetic change) / the walls' work by the trapezoid rule on the step-end forces,
-  // which the exact state matches to O(dt^2) [-]
-  double trapezoid_ratio = 0;
-  int retries = 0;  // steps redone as two half steps, as the app's step controller does
-  std::int64_t factorizations = 0, solves = 0;  // summed over the steps
-  std::int64_t projected = 0;       // factorisations redone with the projected tangent (indefinite)
-  double contact_dissipation = 0;   // wall work - work of the contact impulses (ledger) / wall work
-  double transfer_dissipation = 0;  // kinetic energy the P2G and G2P remove / wall work
-  double bulk_dissipation = 0;      // (-stress work on the grid - elastic change) / wall work
-  bool converged = true;
-  std::string failure;
-  std::string first_failure;  // why the first step redone as half steps failed
-};
+using test_support::BlockResult;
+using test_support::Squeeze;
 
-// Lateral stretch a of plane-strain uniaxial stress at vertical stretch s: sigma11 = 0, i.e.
-// mu (a^2 - 1) + lambda ln(a s) = 0 (method.md §7 with F = diag(a, s)), by Newton from a = 1.
-double lateral_stretch(double lambda, double mu, double s) {
-  double a = 1.0;
-  for (int k = 0; k < 50; ++k) {
-    const double f = mu * (a * a - 1) + lambda * std::log(a * s), df = 2 * mu * a + lambda / a;
-    a -= f / df;
-    if (std::abs(f) < 1e-15 * (mu + lambda)) break;
-  }
-  return a;
-}
-
-// How the block is loaded: top wall down at V = 0.4 m/s to s = s_end in `steps` steps (theta = 1).
-struct Squeeze {
-  double lambda = 0;  // [Pa]
-  double s_end = 0.5;
-  int steps = 333;
-  grid::ShapeKind shape = grid::ShapeKind::kCpdi;
-  bool affine = true, wall_points = true, modified_newton = false;
-  // false: uniaxial stress (top and bottom walls only, sides free)
-  bool side_walls = true;
-  // V2 [m/s]: the right wall moves left at V2 (biaxial; needs side walls)
-  double side_speed = 0;
-  // [m]: moves the block sideways (a multiple of the point spacing h/2: lattice seeding keeps the
-  // sites on that lattice)
-  double offset = 0;
-  // Newton's relative residual and increment, and the contact impulses' relative change
-  double residual_tolerance = 1e-12, impulse_tolerance = 1e-12;
-  // true: the block is two grains, [lo, 1 mm] and [1 mm, hi], the lower pushed by the upper
-  // through grain-grain contact (contact.grain_contact = "faces" when `grain_faces`)
-  bool two_grains = false, grain_faces = true;
-  // true: contact problems solved by block principal pivoting (contact.solver = "active_set")
-  bool active_set = false;
-};
-
-// Block [0.5, 1.5] mm^2 (h = 0.1 mm, 2x2 points per cell). With side walls (uniaxial strain, or
-// biaxial when the right wall moves left at V2, starting from v_x = -V2 (x - 0.5 mm)/W0) on a
-// 2 mm grid; without (uniaxial stress) on a 4 mm grid with the block centred at x = 2 mm,
-// starting with the lateral velocity of the quasi-static path at s = 1,
-// v_x = λ/(λ + 2μ) V (x - 2 mm)/H0 (the linearised sigma11 = 0).
+// The driver of tests/support/wall_block.hpp in 2D: the block [0.5, 1.5] mm^2, h = 0.1 mm.
 BlockResult squeeze(const Squeeze& c) {
-  const auto start = std::chrono::steady_clock::now();
-  const double lambda = c.lambda, s_end = c.s_end;
-  const int steps = c.steps;
-  const bool side_walls = c.side_walls;
-  constexpr double mu = 1.5e6, rho = 990.0, h = 1e-4, lo = 5e-4, hi = 1.5e-3, V = 0.4;
-  const double V2 = c.side_speed;
-  // x of the block's left edge minus lo [m]
-  const double shift = (side_walls ? 0.0 : 1.5e-3) + c.offset;
-  const double xc = lo + shift + 0.5 * (hi - lo), rate = lambda / (lambda + 2 * mu) * V / (hi - lo);
-  auto model =
-      test_support::make_model(h, side_walls ? 20 : 40, 20, "neo_hookean", lambda, mu, rho);
-  const auto velocity = [&](const Vec<2>& x) {
-    const double vx = side_walls ? -V2 * (x[0] - lo) / (hi - lo) : rate * (x[0] - xc);
-    return Vec<2>(vx, -V * (x[1] - lo) / (hi - lo));
-  };
-  const double mid = c.two_grains ? 0.5 * (lo + hi) : hi;
-  test_support::add_box(model, Vec<2>(lo + shift, lo), Vec<2>(hi + shift, mid), 2, velocity);
-  if (c.two_grains)
-    test_support::add_box(model, Vec<2>(lo + shift, mid), Vec<2>(hi + shift, hi), 2, velocity);
-  mpm::Settings<2> s;
-  s.shape = c.shape;
-  s.affine = c.affine;
-  s.modified_newton = c.modified_newton;
-  s.theta = 1.0;
-  s.residual_tolerance = s.increment_tolerance = c.residual_tolerance;
-  s.contact.enabled = true;
-  s.contact.wall_points = c.wall_points;
-  s.contact.grain_faces = c.grain_faces;
-  s.contact.active_set = c.active_set;
-  s.contact.gs.tolerance = 1e-12;
-  s.contact.impulse_tolerance = c.impulse_tolerance;
-  s.contact.walls = {{"bottom", Vec<2>(0, lo), Vec<2>(0, 1), Vec<2>::Zero(), 0.0},
-                     {"top", Vec<2>(0, hi), Vec<2>(0, -1), Vec<2>(0, -V), 0.0},
-                     {"left", Vec<2>(lo, 0), Vec<2>(1, 0), Vec<2>::Zero(), 0.0},
-                     {"right", Vec<2>(hi, 0), Vec<2>(-1, 0), Vec<2>(-V2, 0), 0.0}};
-  if (!side_walls) s.contact.walls.resize(2);
-  mpm::ImplicitSolver<2> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
-  const double H0 = hi - lo, dt = (1.0 - s_end) * H0 / V / steps;
-  const auto d0 = mpm::diagnostics(model);
-  BlockResult r;
-  // The closed form at time t: stretches a, s, J = a s and sigma11, sigma22 (method.md §7).
-  struct Exact {
-    double a, s, J, s11, s22;
-  };
-  const auto exact = [&](double time) {
-    Exact e;
-    e.s = 1.0 - V * time / H0;
-    e.a = !side_walls ? lateral_stretch(lambda, mu, e.s) : 1.0 - V2 * time / H0;
-    e.J = e.a * e.s;
-    e.s11 = (mu * (e.a * e.a - 1) + lambda * std::log(e.J)) / e.J;
-    e.s22 = (mu * (e.s * e.s - 1) + lambda * std::log(e.J)) / e.J;
-    return e;
-  };
-  double work = 0, trapezoid = 0, t = 0, force = 0, side_force = 0, contact_work = 0, transfer = 0,
-         stress_work = 0;
-  // One step of size `step`; a failed step is redone as two half steps (up to 1/16), as the
-  // app's controller cuts dt (docs/accuracy.md lists the failures this still meets).
-  std::function<bool(double, int)> advance = [&](double step, int depth) {
-    solver.set_time(t);
-    const auto st = solver.solve_step(step);
-    if (!st.converged) {
-      if (depth == 4) {
-        r.failure = st.failure + " at t = " + std::to_string(t);
-        return false;
-      }
-      if (r.retries++ == 0) {
-        r.first_retry_at = exact(t).s;
-        r.first_failure = st.failure;
-      }
-      return advance(step / 2, depth + 1) && advance(step / 2, depth + 1);
-    }
-    solver.commit();
-    r.factorizations += st.factorizations;
-    r.projected += st.projected_factorizations;
-    contact_work += st.contact_work;
-    transfer += st.transfer_loss;
-    stress_work += st.stress_work;
-    r.solves += st.linear_solves;
-    t += step;
-    const double force0 = force, side_force0 = side_force;
-    force = st.wall_force[1][1];  // force of the grain on the top wall (+y) [N/m]
-    work += force * V * step;     // the wall moves down at V against it
-    if (side_walls) {
-      side_force = st.wall_force[3][0];  // on the right wall (+x) [N/m]
-      work += side_force * V2 * step;    // which moves left at V2
-    }
-    trapezoid += 0.5 * ((force0 + force) * V + (side_force0 + side_force) * V2) * step;
-    const auto e = exact(t);
-    const double scale = std::max(std::abs(e.s11), std::abs(e.s22));
-    double worst = 0;
-    for (std::size_t p = 0; p < model.points.size(); ++p) {
-      const double dJ = std::abs(model.points.F[p].determinant() - e.J);
-      r.run_worst_J = std::max(r.run_worst_J, dJ);
-      worst = std::max({worst, dJ, std::abs(model.points.sigma[p](0, 0) - e.s11) / scale,
-                        std::abs(model.points.sigma[p](1, 1) - e.s22) / scale});
-    }
-    if (worst > 1e-3 && r.lost_at == 1.0) r.lost_at = e.s;
-    return true;
-  };
-  for (int k = 0; k < steps; ++k)
-    if (!advance(dt, 0)) {
-      r.converged = false;
-      std::printf(
-          "  lambda %.3g MPa: failed at s = %.4f (%s), first half step at s = %.4f, "
-          "state lost at s = %.4f\n",
-          lambda / 1e6, exact(t).s, r.failure.c_str(), r.first_retry_at, r.lost_at);
-      return r;
-    }
-  const auto e = exact(t);
-  const double sf = e.s, a = e.a, J = e.J, s11 = e.s11, s22 = e.s22;
-  const double s11_scale = V2 > 0 ? std::abs(s11) : std::abs(s22);
-  for (std::size_t p = 0; p < model.points.size(); ++p) {
-    r.worst_J = std::max(r.worst_J, std::abs(model.points.F[p].determinant() - J));
-    r.worst_sigma =
-        std::max(r.worst_sigma, std::abs(model.points.sigma[p](1, 1) - s22) / std::abs(s22));
-    r.worst_sigma11 =
-        std::max(r.worst_sigma11, std::abs(model.points.sigma[p](0, 0) - s11) / s11_scale);
-  }
-  r.force_error = std::abs(force - (-s22 * a * H0)) / std::abs(s22 * a * H0);
-  if (V2 > 0)
-    r.side_force_error = std::abs(side_force - (-s11 * sf * H0)) / std::abs(s11 * sf * H0);
-  const auto d = mpm::diagnostics(model);
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.last_step_work = (force * V + side_force * V2) * dt / work;
-  r.energy_ratio = (d.elastic + d.kinetic - d0.elastic - d0.kinetic) / work;
-  r.trapezoid_ratio = (d.elastic + d.kinetic - d0.elastic - d0.kinetic) / trapezoid;
-  r.contact_dissipation = (work - contact_work) / work;
-  r.transfer_dissipation = transfer / work;
-  r.bulk_dissipation = (-stress_work - (d.elastic - d0.elastic)) / work;
-  std::printf(
-      "  lambda %.3g MPa, s = %.3f: max |J - J_exact| = %.2e, max rel. sigma22 error = %.2e, "
-      "top force error = %.2e, (elastic + kinetic change) / wall work = %.5f (one step's final "
-      "work %.5f), contact "
-      "dissipation / wall work = %.2e, transfers %.2e, bulk %.2e, %d steps "
-      "redone as half steps (first at s = %.4f), %lld factorisations (%lld projected) for %lld "
-      "solves; state lost (1e-3) at s = %.4f; %.1f s\n",
-      lambda / 1e6, sf, r.worst_J, r.worst_sigma, r.force_error, r.energy_ratio, r.last_step_work,
-      r.contact_dissipation, r.transfer_dissipation, r.bulk_dissipation, r.retries,
-      r.first_retry_at, static_cast<long long>(r.factorizations),
-      static_cast<long long>(r.projected), static_cast<long long>(r.solves), r.lost_at, r.seconds);
-  if (r.retries > 0) std::printf("  first half steps after: %s\n", r.first_failure.c_str());
-  if (V2 > 0)
-    std::printf(
-        "  biaxial a = %.4f: max rel. sigma11 error = %.2e, right force error = %.2e, (elastic + "
-        "kinetic change) / trapezoid wall work = %.6f\n",
-        a, r.worst_sigma11, r.side_force_error, r.trapezoid_ratio);
-  return r;
+  return test_support::squeeze_block<2>(c);
 }
 
 }  // namespace
