@@ -129,62 +129,125 @@ void forward_substitute(Work& w) {
 }  // namespace
 
 template <int Dim>
+void ImplicitSolver<Dim>::build_slot_bases() {
+  // The impulse a slot receives is a sum of its contacts' impulses: along their normals when they
+  // are frictionless, anywhere in R^Dim otherwise. Its basis: Gram-Schmidt on those normals, in
+  // contact order (a normal within 1e-6 of the span of the earlier ones adds nothing), the
+  // identity once Dim directions are needed.
+  const std::size_t ns = problem_.slots.size();
+  slot_basis_.assign(ns, Mat<Dim>::Zero());
+  slot_rank_.assign(ns, 0);
+  const auto add = [&](std::int32_t s, const Vec<Dim>& n, bool frictional) {
+    if (s < 0) return;
+    Mat<Dim>& B = slot_basis_[static_cast<std::size_t>(s)];
+    int& r = slot_rank_[static_cast<std::size_t>(s)];
+    if (r == Dim) return;
+    if (frictional) {
+      B.setIdentity();
+      r = Dim;
+      return;
+    }
+    Vec<Dim> v = n;
+    for (int m = 0; m < r; ++m) v -= B.col(m).dot(v) * B.col(m);
+    if (!(v.norm() > 1e-6 * n.norm())) return;
+    B.col(r++) = v.normalized();
+    if (r == Dim) B.setIdentity();
+  };
+  for (const auto& c : problem_.contacts) {
+    const bool frictional = c.friction != 0.0;
+    add(c.a, c.normal, frictional);
+    add(c.b, c.normal, frictional);
+  }
+  slot_bases_valid_ = true;
+}
+
+template <int Dim>
 bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
-  // Z = A^-1 E (response of the grain's velocities to unit impulses at its slots; A^-1 -> M^-1
-  // for a lumped group) and its slot rows G = E^T Z, from the factorisation of the current Newton
-  // matrix. Column (j, d) of E is sum_k w_jk e_{a_jk, d} (one node of weight 1 for a node slot).
+  // Z = A^-1 E B (response of the grain's velocities to unit impulses at its slots along their
+  // basis directions B; A^-1 -> M^-1 for a lumped group) and its slot rows G = B (B^T E^T Z) B^T,
+  // from the factorisation of the current Newton matrix. Column (j, d) of E is
+  // sum_k w_jk e_{a_jk, d} (one node of weight 1 for a node slot). The impulses on slot j lie in
+  // the span of B_j (its frictionless contacts' normals, or all directions), so G P and Z B^T P
+  // are exact, and the contact solvers read G only along those directions (a frictionless
+  // contact's normal velocity and n^T W n): with one normal per face slot, 1/Dim of the columns of
+  // the full E (docs/contact.md, "Compliance on the contact directions").
   GrainWork& w = *work_[g];
   if (!w.lumped_group) {
     if (!reuse_factor(w, settings_) && !grain_factor(g, dt_)) return true;
-    // Z and G depend only on the factorisation and the slots (fixed within a step).
+    // Z and G depend only on the factorisation, the slots and their contacts (fixed in a step).
     if (w.z_factor == w.factor_count) return false;
     w.z_factor = w.factor_count;
   }
   const auto k = static_cast<Eigen::Index>(w.slots.size());
   const auto ndof = static_cast<Eigen::Index>(w.m.size() * Dim);
   Eigen::MatrixXd& G = problem_.groups[problem_.slots[w.slots[0]].group].G;
-  // With an LDL^T factorisation P A P^T = L D L^T, G = E^T A^-1 E = Y^T D^-1 Y with
-  // Y = L^-1 P E: forward substitutions only, and Y stays sparse because E's columns touch a
+  w.z_col.assign(static_cast<std::size_t>(k) + 1, 0);
+  for (Eigen::Index j = 0; j < k; ++j)
+    w.z_col[static_cast<std::size_t>(j) + 1] =
+        w.z_col[static_cast<std::size_t>(j)] + slot_rank_[static_cast<std::size_t>(w.slots[j])];
+  const Eigen::Index ncol = w.z_col.back();
+  // With an LDL^T factorisation P A P^T = L D L^T, B^T E^T A^-1 E B = Y^T D^-1 Y with
+  // Y = L^-1 P E B: forward substitutions only, and Y stays sparse because E's columns touch a
   // few nodes (the triangular solve skips zero entries). 4x cheaper than Z = A^-1 E for a CPDI
   // disk (docs/accuracy.md, cost); the velocity response then takes one back substitution.
   w.z_forward = !w.lumped_group && settings_.linear_solver == LinearSolverKind::kLdlt;
-  // Column (j, d) of E, without the prescribed components (which do not respond).
-  w.Z.setZero(ndof, Dim * k);
+  // Column (j, m) of E B, without the prescribed components (which do not respond).
+  w.Z.setZero(ndof, ncol);
   for (Eigen::Index j = 0; j < k; ++j) {
     const std::size_t s = static_cast<std::size_t>(w.slots[j]);
-    for (int d = 0; d < Dim; ++d)
+    const Mat<Dim>& B = slot_basis_[s];
+    for (Eigen::Index m = 0; m < slot_rank_[s]; ++m)
       for (std::int32_t q = slot_start_[s]; q < slot_start_[s + 1]; ++q) {
         const std::int32_t a = slot_node_[q];
-        if (w.mask[a] & (1u << d)) continue;
-        w.Z(a * Dim + d, Dim * j + d) = slot_weight_[q] / (w.lumped_group ? w.m[a] : 1.0);
+        const double f = slot_weight_[q] / (w.lumped_group ? w.m[a] : 1.0);
+        for (int d = 0; d < Dim; ++d)
+          if (!(w.mask[a] & (1u << d)) && B(d, m) != 0.0)
+            w.Z(a * Dim + d, w.z_col[static_cast<std::size_t>(j)] + m) = f * B(d, m);
       }
   }
+  Eigen::MatrixXd Gr;  // B^T G B: the compliance on the slots' directions [s/kg]
   if (w.z_forward) {
     forward_substitute(w);
     const Eigen::VectorXd& d = w.ldlt.vectorD();
     if (!(d.array() > 0.0).all()) {
-      G.noalias() = w.Z.transpose() * d.cwiseInverse().asDiagonal() * w.Z;
-      return true;
+      Gr.noalias() = w.Z.transpose() * d.cwiseInverse().asDiagonal() * w.Z;
+    } else {
+      // D > 0 (the projected tangent keeps the grains' Newton matrices positive definite when
+      // they serve a compliance): S^T S with S = D^-1/2 Y, one triangle by a symmetric rank
+      // update (half the flops of the general product), mirrored.
+      const Eigen::MatrixXd S = d.cwiseInverse().cwiseSqrt().asDiagonal() * w.Z;
+      Gr.setZero(S.cols(), S.cols());
+      Gr.selfadjointView<Eigen::Lower>().rankUpdate(S.transpose());
+      Gr.triangularView<Eigen::StrictlyUpper>() = Gr.transpose();
     }
-    // D > 0 (the projected tangent keeps the grains' Newton matrices positive definite when
-    // they serve a compliance): G = S^T S with S = D^-1/2 Y, one triangle by a symmetric rank
-    // update (half the flops of the general product), mirrored.
-    const Eigen::MatrixXd S = d.cwiseInverse().cwiseSqrt().asDiagonal() * w.Z;
-    G.setZero(S.cols(), S.cols());
-    G.selfadjointView<Eigen::Lower>().rankUpdate(S.transpose());
-    G.triangularView<Eigen::StrictlyUpper>() = G.transpose();
-    return true;
+  } else {
+    if (!w.lumped_group)
+      for (Eigen::Index c = 0; c < ncol; ++c)
+        if (w.Z.col(c).squaredNorm() > 0) w.Z.col(c) = linear_solve(w, settings_, w.Z.col(c));
+    Gr.setZero(ncol, ncol);
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const std::size_t s = static_cast<std::size_t>(w.slots[i]);
+      Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(Dim, ncol);  // E_i^T Z
+      for (std::int32_t q = slot_start_[s]; q < slot_start_[s + 1]; ++q)
+        rows += slot_weight_[q] * w.Z.middleRows(slot_node_[q] * Dim, Dim);
+      Gr.middleRows(w.z_col[static_cast<std::size_t>(i)], slot_rank_[s]) =
+          slot_basis_[s].leftCols(slot_rank_[s]).transpose() * rows;
+    }
   }
-  if (!w.lumped_group)
-    for (Eigen::Index c = 0; c < Dim * k; ++c)
-      if (w.Z.col(c).squaredNorm() > 0) w.Z.col(c) = linear_solve(w, settings_, w.Z.col(c));
-  G.resize(Dim * k, Dim * k);
-  for (Eigen::Index i = 0; i < k; ++i) {
-    const std::size_t s = static_cast<std::size_t>(w.slots[i]);
-    G.middleRows(Dim * i, Dim) =
-        slot_weight_[slot_start_[s]] * w.Z.middleRows(slot_node_[slot_start_[s]] * Dim, Dim);
-    for (std::int32_t q = slot_start_[s] + 1; q < slot_start_[s + 1]; ++q)
-      G.middleRows(Dim * i, Dim) += slot_weight_[q] * w.Z.middleRows(slot_node_[q] * Dim, Dim);
+  // G = B Gr B^T on the slots' full Dim x Dim blocks.
+  G.setZero(Dim * k, Dim * k);
+  for (Eigen::Index j = 0; j < k; ++j) {
+    const std::size_t sj = static_cast<std::size_t>(w.slots[j]);
+    const auto Bj = slot_basis_[sj].leftCols(slot_rank_[sj]);
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const std::size_t si = static_cast<std::size_t>(w.slots[i]);
+      const auto Bi = slot_basis_[si].leftCols(slot_rank_[si]);
+      G.block(Dim * i, Dim * j, Dim, Dim).noalias() =
+          Bi *
+          Gr.block(w.z_col[static_cast<std::size_t>(i)], w.z_col[static_cast<std::size_t>(j)],
+                   slot_rank_[si], slot_rank_[sj]) *
+          Bj.transpose();
+    }
   }
   return true;
 }
@@ -193,6 +256,7 @@ template <int Dim>
 double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   // Response of each grain: its compliance group (exact, linearised) or the lumped 1/m_I.
   const auto ngroups = static_cast<std::int64_t>(problem_.groups.size());
+  if (!slot_bases_valid_) build_slot_bases();
   bool new_compliance = false;
   ThreadedRegion threaded(&timers_, ngroups > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1) reduction(|| : new_compliance)
@@ -304,17 +368,20 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     const contact::Group& group = problem_.groups[static_cast<std::size_t>(gi)];
     const std::int32_t g = slot_ref_[group.slots[0]].first;
     GrainWork& w = *work_[g];
-    Eigen::VectorXd dP(Dim * static_cast<Eigen::Index>(group.slots.size()));
+    Eigen::VectorXd dP(w.z_col.back());  // B^T (P - P_old), slot after slot
     bool changed = false;
     for (std::size_t j = 0; j < group.slots.size(); ++j) {
       const std::int32_t s = group.slots[j];
       const Vec<Dim> d = slot_p[s] - slot_P_[s];
       changed = changed || d != Vec<Dim>::Zero();
-      dP.template segment<Dim>(Dim * static_cast<Eigen::Index>(j)) = d;
+      const int r = slot_rank_[static_cast<std::size_t>(s)];
+      dP.segment(w.z_col[j], r) =
+          slot_basis_[static_cast<std::size_t>(s)].leftCols(r).transpose() * d;
       slot_P_[s] = slot_p[s];
     }
     if (!changed) continue;
-    // dv = A^-1 E dP = Z dP, or P^T L^-T D^-1 Y dP with the forward-only response.
+    // dv = A^-1 E B B^T dP = Z B^T dP (dP lies in the span of B), or P^T L^-T D^-1 Y B^T dP with
+    // the forward-only response.
     Eigen::VectorXd dv = w.Z * dP;
     if (w.z_forward) {
       dv = w.ldlt.vectorD().cwiseInverse().asDiagonal() * dv;
@@ -355,6 +422,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   template Vec<D> ImplicitSolver<D>::slot_velocity(std::size_t) const;               \
   template void ImplicitSolver<D>::spread_slot_impulses();                           \
   template bool ImplicitSolver<D>::grain_compliance(std::size_t);                    \
+  template void ImplicitSolver<D>::build_slot_bases();                               \
   template double ImplicitSolver<D>::update_contacts(StepStats&);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)

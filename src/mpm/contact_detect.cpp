@@ -43,6 +43,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   problem_.law = cs.law;
   problem_.slots.clear();
   problem_.contacts.clear();
+  slot_bases_valid_ = false;
   sweep_order_ready_ = false;
   as_cache_.valid = false;
   slot_ref_.clear();
@@ -358,7 +359,11 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   walls_stage.done();
   detect_items_ = items;
   ScopedStage groups_stage(&timers_, "contact.detect.groups");
-  // Warm start: the grains see the previous step's impulses from the first iteration on.
+  // Warm start: the grains see the previous step's impulses from the first iteration on; a
+  // frictionless contact's along its normal of this step (max(0, P . n) n: the impulse it can
+  // take, and the directions its slots' compliance is computed on, build_slot_bases).
+  for (auto& c : problem_.contacts)
+    if (c.friction == 0.0) c.impulse = std::max(0.0, c.impulse.dot(c.normal)) * c.normal;
   slot_P_ = contact::net_impulses(problem_);
   spread_slot_impulses();
   gs_converged_ = true;

@@ -20,7 +20,10 @@ template <int Dim>
 struct ImplicitSolver<Dim>::GrainWork : GrainField<Dim> {
   std::vector<std::int32_t> slots;  // contact slots of this grain (its compliance group)
   bool lumped_group = false;        // its group's response is M^-1 E (no factorisation)
-  Eigen::MatrixXd Z;                // A^-1 E: response of all dofs to unit slot impulses [s/kg]
+  // A^-1 E B: response of all dofs to unit slot impulses along the slots' basis directions B
+  // (slot_basis_, columns slot after slot) [s/kg]
+  Eigen::MatrixXd Z;
+  std::vector<Eigen::Index> z_col;  // first column of each slot's directions in Z (size slots + 1)
   bool z_forward = false;           // Z holds Y = L^-1 P E instead (LDL^T: grain_compliance)
   std::int64_t z_factor = -1;       // the factorisation Z and G were computed with (-1: none)
   // The factorisation serves a contact compliance (prepare_factor's `compliance`).

@@ -145,6 +145,8 @@ class ImplicitSolver {
   // Grain g's compliance group G (and Z) from its current factorisation; true when G was
   // recomputed (a new factorisation, or a lumped group).
   bool grain_compliance(std::size_t g);
+  // Fills slot_basis_ and slot_rank_ from this step's contacts.
+  void build_slot_bases();
   void detect_contacts(double dt);
   double update_contacts(StepStats& stats);
   std::int32_t slot_of(std::int32_t g, std::int32_t a);
@@ -194,6 +196,12 @@ class ImplicitSolver {
   std::vector<std::int32_t> slot_start_{0}, slot_node_;
   std::vector<double> slot_weight_;
   std::vector<Vec<Dim>> slot_P_;
+  // Per slot: an orthonormal basis (first slot_rank_ columns) of the directions its contacts'
+  // impulses take this step: the normals of its frictionless contacts, all of R^Dim when one is
+  // frictional (build_slot_bases; the compliance is computed on these directions only).
+  std::vector<Mat<Dim>> slot_basis_;
+  std::vector<int> slot_rank_;
+  bool slot_bases_valid_ = false;  // built for this step's contacts
   std::vector<char> slot_is_face_;
   // Per slot: warm-start key, the global node of a node slot, -1 - cell of a face slot.
   std::vector<std::int64_t> slot_key_;
