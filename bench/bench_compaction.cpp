@@ -1,16 +1,19 @@
-// Steps of the paper compaction in its dense state (issue 16; docs/parallel.md, "Dense-state
-// benchmark"): each checkpoint given (a run of examples/paper_compaction stopped near Phi = 0.9,
-// made by tools/compaction_checkpoints.sh) is restored as `mpmcd run --restart` restores it
-// (app::restore_from_checkpoint: the input stored in the checkpoint, its settings, its warm start
-// and time step), then `--warmup` steps are taken untimed and `--steps` timed, as the app's loop
-// takes them (boundaries at t + dt, a failed step retried with a cut dt). Per step: wall time (the
-// benchmark's time), the share of the wall time of each solver stage (p2g, contact.detect,
+// Steps of the paper compaction in its dense state, 2D or 3D (issue 16; docs/parallel.md,
+// "Dense-state benchmark"): each checkpoint given (a run of examples/paper_compaction stopped near
+// Phi = 0.9, made by tools/compaction_checkpoints.sh) is restored as `mpmcd run --restart` restores
+// it (app::restore_from_checkpoint: the input stored in the checkpoint, its settings, its warm
+// start and time step), then `--warmup` steps are taken untimed and `--steps` timed, as the app's
+// loop takes them (boundaries at t + dt, a failed step retried with a cut dt). Per step: wall time
+// (the benchmark's time), the share of the wall time of each solver stage (p2g, contact.detect,
 // newton.assemble, newton.solve, contact.solve, g2p), one_thread_fraction (share of the wall time
 // on one thread, as `mpmcd run` reports it), contacts, Gauss-Seidel sweeps, Newton iterations.
 //   tools/compaction_checkpoints.sh d4
 //   build/release/bench/bench_compaction build/compaction_checkpoints/lambda3_d4.h5
 //     --benchmark_counters_tabular=true --benchmark_repetitions=3
 //     --benchmark_enable_random_interleaving=true          (one command line)
+// 3D (docs/three_d.md, "Compaction in 3D"): a checkpoint of examples/compaction_3d, e.g.
+//   build/release/mpmcd run examples/compaction_3d/compaction_3d_quick.toml -o build/c3d
+//     --stop-after 84                                      (Phi = 0.745; exits 4)
 // Checkpoints: the arguments left after Google Benchmark's, else MPMCD_COMPACTION_CHECKPOINTS
 // (paths separated by ':'); none: the benchmark is skipped with a message. Own options:
 // `--steps N` (5), `--warmup N` (1), `--threads 1,2` (thread counts). A repetition restores the
@@ -60,9 +63,10 @@ std::vector<std::string> split(const std::string& text, char sep) {
 // The solver of a restored run, set up as app::detail::Run sets it up on one process, and its
 // loop: `step` takes one committed step as Run::go does (dt from the step controller, boundaries
 // at t + dt, a failed attempt retried with a cut dt, counted in `retries`).
+template <int Dim>
 class RestoredStepper {
  public:
-  explicit RestoredStepper(app::RestoredRun& run)
+  explicit RestoredStepper(app::RestoredRun<Dim>& run)
       : run_(run),
         solver_(run.model.grid, run.settings, run.model.points, run.model.grains,
                 run.model.law_ptrs()),
@@ -96,30 +100,32 @@ class RestoredStepper {
     }
   }
 
-  mpm::ImplicitSolver<2>& solver() { return solver_; }
+  mpm::ImplicitSolver<Dim>& solver() { return solver_; }
   double time() const { return t_; }
   int retries = 0;  // failed attempts retried with a cut dt
 
  private:
-  app::RestoredRun& run_;
-  mpm::ImplicitSolver<2> solver_;
+  app::RestoredRun<Dim>& run_;
+  mpm::ImplicitSolver<Dim> solver_;
   app::StepController dt_control_;
   bool moving_;
   double t_;
 };
 
-// Restores `path` on `threads` threads and times the steps (one step per iteration).
-void BM_DenseSteps(benchmark::State& state, const std::string& path, int threads, int warmup) {
+// Restores `path` (a run of dimension Dim) on `threads` threads and times the steps (one step per
+// iteration).
+template <int Dim>
+void dense_steps(benchmark::State& state, const std::string& path, int threads, int warmup) {
   omp_set_num_threads(threads);
-  std::optional<app::RestoredRun> restored;
+  std::optional<app::RestoredRun<Dim>> restored;
   try {
-    restored.emplace(app::restore_from_checkpoint(path));
+    restored.emplace(app::restore_from_checkpoint<Dim>(path));
   } catch (const std::exception& e) {
     state.SkipWithError((path + ": " + e.what()).c_str());
     return;
   }
-  app::RestoredRun& run = *restored;
-  RestoredStepper stepper(run);
+  app::RestoredRun<Dim>& run = *restored;
+  RestoredStepper<Dim> stepper(run);
   for (int i = 0; i < warmup; ++i)
     if (const auto st = stepper.step(); !st.converged) {
       state.SkipWithError(("warm-up step: " + st.failure).c_str());
@@ -158,12 +164,15 @@ void BM_DenseSteps(benchmark::State& state, const std::string& path, int threads
     rows.push_back({.name = name, .max = secs, .mean = secs, .min = secs});
   state.counters["one_thread_fraction"] =
       parallel::one_thread_fraction(rows, wall, threads, parallel::Comm::SoloReport{});
-  app::CompactionObserver observer(run.config, run.model);
-  const auto now = observer.now(
-      app::CompactionObserver<2>::total_area(app::CompactionObserver<2>::grain_areas(run.model)),
-      {}, stepper.time());
+  app::CompactionObserver<Dim> observer(run.config, run.model);
+  const auto now = observer.now(app::CompactionObserver<Dim>::total_area(
+                                    app::CompactionObserver<Dim>::grain_areas(run.model)),
+                                {}, stepper.time());
   state.counters["phi"] = now ? now->phi : 0.0;
   state.counters["points"] = static_cast<double>(run.model.points.size());
+  // Point-steps per second of the whole step (contact included) [1/s].
+  state.counters["point_steps_per_s"] =
+      wall > 0 ? static_cast<double>(run.model.points.size()) * steps / wall : 0.0;
   state.counters["contacts"] = contacts / steps;
   state.counters["active"] = active / steps;
   state.counters["gs_sweeps"] = sweeps / steps;
@@ -171,6 +180,21 @@ void BM_DenseSteps(benchmark::State& state, const std::string& path, int threads
   state.counters["factorizations"] = factorizations / steps;
   state.counters["projected"] = projected / steps;
   state.counters["retries"] = stepper.retries;
+}
+
+// The dense steps of checkpoint `path`, 2D or 3D as its input says.
+void BM_DenseSteps(benchmark::State& state, const std::string& path, int threads, int warmup) {
+  int dimension = 2;
+  try {
+    dimension = app::load_restart(path, "").config.simulation.dimension;
+  } catch (const std::exception& e) {
+    state.SkipWithError((path + ": " + e.what()).c_str());
+    return;
+  }
+  if (dimension == 3)
+    dense_steps<3>(state, path, threads, warmup);
+  else
+    dense_steps<2>(state, path, threads, warmup);
 }
 
 // Reads the options left after Google Benchmark's; false (with a message) on a bad one.

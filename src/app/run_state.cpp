@@ -310,13 +310,21 @@ Restart load_restart(const std::string& path, const std::string& input) {
   return r;
 }
 
-RestoredRun restore_from_checkpoint(const std::string& path, const std::string& input) {
+template <int Dim>
+RestoredRun<Dim> restore_from_checkpoint(const std::string& path, const std::string& input) {
   Restart r = load_restart(path, input);
-  mpm::Model<2> model = restore_model<2>(r.config, r.state, path);
-  mpm::Settings<2> settings = build_settings(r.config, model);
-  std::vector<mpm::WarmImpulse<2>> warm = warm_start_of<2>(r.state);
-  return RestoredRun{std::move(r.config), std::move(r.state), std::move(model),
-                     std::move(settings), std::move(warm),    path};
+  if (r.config.simulation.dimension != Dim)
+    throw InputError(path, 0, "simulation.dimension",
+                     fmt::format("a {}D run asked of a checkpoint of dimension {}", Dim,
+                                 r.config.simulation.dimension));
+  mpm::Model<Dim> model = restore_model<Dim>(r.config, r.state, path);
+  mpm::Settings<Dim> settings = build_settings(r.config, model);
+  std::vector<mpm::WarmImpulse<Dim>> warm = warm_start_of<Dim>(r.state);
+  return RestoredRun<Dim>{std::move(r.config), std::move(r.state), std::move(model),
+                          std::move(settings), std::move(warm),    path};
 }
+
+template RestoredRun<2> restore_from_checkpoint<2>(const std::string&, const std::string&);
+template RestoredRun<3> restore_from_checkpoint<3>(const std::string&, const std::string&);
 
 }  // namespace mpmcd::app

@@ -81,19 +81,24 @@ struct Restart {
 /// text stored in the checkpoint. Throws InputError (exit 2).
 Restart load_restart(const std::string& path, const std::string& input);
 
-/// A 2D run restored from a checkpoint file, ready to step on (a solver built from `model` and
-/// `settings`, boundaries at state.time, warm start `warm`).
+/// A run of dimension Dim restored from a checkpoint file, ready to step on (a solver built from
+/// `model` and `settings`, boundaries at state.time, warm start `warm`).
+template <int Dim = 2>
 struct RestoredRun {
-  io::Config config;          ///< the input of the run
-  checkpoint::State state;    ///< the checkpoint: time, dt, counters, ledger, distribution
-  mpm::Model<2> model;        ///< grid, materials, points and grains at the checkpoint
-  mpm::Settings<2> settings;  ///< solver settings from the input
-  std::vector<mpm::WarmImpulse<2>> warm;  ///< contact impulses of the last step (warm start)
-  std::string path;                       ///< the checkpoint file
+  io::Config config;            ///< the input of the run
+  checkpoint::State state;      ///< the checkpoint: time, dt, counters, ledger, distribution
+  mpm::Model<Dim> model;        ///< grid, materials, points and grains at the checkpoint
+  mpm::Settings<Dim> settings;  ///< solver settings from the input
+  std::vector<mpm::WarmImpulse<Dim>> warm;  ///< contact impulses of the last step (warm start)
+  std::string path;                         ///< the checkpoint file
 };
 
 /// Restores the run of checkpoint `path` with its input (`input`, or the text the checkpoint
-/// holds if empty: load_restart). Throws InputError (exit 2).
-RestoredRun restore_from_checkpoint(const std::string& path, const std::string& input = "");
+/// holds if empty: load_restart); its `[simulation] dimension` must be Dim. Throws InputError
+/// (exit 2).
+template <int Dim = 2>
+RestoredRun<Dim> restore_from_checkpoint(const std::string& path, const std::string& input = "");
+extern template RestoredRun<2> restore_from_checkpoint<2>(const std::string&, const std::string&);
+extern template RestoredRun<3> restore_from_checkpoint<3>(const std::string&, const std::string&);
 
 }  // namespace mpmcd::app
