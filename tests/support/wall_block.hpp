@@ -5,6 +5,8 @@
 // (zero acceleration), against the closed form of method.md §7 after every step. The last axis
 // is "vertical"; the others are lateral, held by side walls (uniaxial strain, F = diag(1, .., s);
 // biaxial when the wall normal to x moves in too) or free (uniaxial stress).
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -326,6 +328,25 @@ BlockResult squeeze_block(const Squeeze& c) {
     std::printf("  triaxial b = %.4f: max rel. sigma_yy error = %.2e, back force error = %.2e\n",
                 e.b, r.worst_sigma_yy, r.back_force_error);
   return r;
+}
+
+// Runs `all` by `squeeze` without each of the three parts of docs/accuracy.md's diagnosis (walls
+// on the points' faces, CPDI shapes, the affine P2G) and expects the exact state lost: the worst
+// relative stress error above 1e-2, 1e-2 and 1e-5.
+template <class Squeezer>
+void expect_each_ingredient_needed(const Squeeze& all, Squeezer&& squeeze) {
+  auto without = all;
+  without.wall_points = false;
+  const auto nodes = squeeze(without);
+  without = all;
+  without.shape = grid::ShapeKind::kLinear;
+  const auto linear = squeeze(without);
+  without = all;
+  without.affine = false;
+  const auto plain = squeeze(without);
+  EXPECT_GT(nodes.worst_sigma, 1e-2);
+  EXPECT_GT(linear.worst_sigma, 1e-2);
+  EXPECT_GT(plain.worst_sigma, 1e-5);
 }
 
 }  // namespace mpmcd::test_support

@@ -87,19 +87,7 @@ TEST(WallBlock, OneContactPerFaceKeepsTheStiffBlockToHalfItsHeight) {
 
 TEST(WallBlock, EachIngredientIsNeeded) {
   // Without any one of the three parts the exact state is lost within s = 0.8 (docs/accuracy.md).
-  const Squeeze all{.lambda = 3e6, .s_end = 0.8, .steps = 60};
-  auto without = all;
-  without.wall_points = false;
-  const auto nodes = squeeze(without);
-  without = all;
-  without.shape = grid::ShapeKind::kLinear;
-  const auto linear = squeeze(without);
-  without = all;
-  without.affine = false;
-  const auto plain = squeeze(without);
-  EXPECT_GT(nodes.worst_sigma, 1e-2);
-  EXPECT_GT(linear.worst_sigma, 1e-2);
-  EXPECT_GT(plain.worst_sigma, 1e-5);
+  test_support::expect_each_ingredient_needed({.lambda = 3e6, .s_end = 0.8, .steps = 60}, squeeze);
 }
 
 TEST(WallBlock, ModifiedNewtonKeepsTheExactStateWithFewerFactorisations) {
