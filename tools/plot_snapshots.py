@@ -440,10 +440,9 @@ def draw_snapshot(pts, arr, field, corners, walls=(), gap=None, contacts=(), net
     return fig, ax, value
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("folder", help="output folder of `mpmcd run`")
-    ap.add_argument("--phi", type=float, nargs="+", required=True, help="solid fractions wanted")
+def add_colour_options(ap, range_scope):
+    """The colouring options (--field, --colours, --range) of the 2D and 3D snapshot tools;
+    range_scope says what shares one colour scale."""
     ap.add_argument("--field", default="grain", choices=FIELDS,
                     help="grain: distinct colours, neighbours never share one; pressure: grain "
                     "pressure; point_pressure, J: per point")
@@ -451,7 +450,14 @@ def main():
                     help="palette size for --field grain (more are used only if the neighbour "
                     "graph needs them)")
     ap.add_argument("--range", type=float, nargs=2, default=(None, None), metavar=("LO", "HI"),
-                    help="ends of the colour scale (MPa for pressures), the same for every Φ")
+                    help="ends of the colour scale (MPa for pressures), " + range_scope)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("folder", help="output folder of `mpmcd run`")
+    ap.add_argument("--phi", type=float, nargs="+", required=True, help="solid fractions wanted")
+    add_colour_options(ap, "the same for every Φ")
     ap.add_argument("-o", "--output", default=None, help="default <folder>/snapshots")
     ap.add_argument("--dots", action="store_true", help="draw the material points as dots")
     ap.add_argument("--dpi", type=int, default=150)

@@ -59,8 +59,9 @@ from matplotlib.patches import PathPatch  # noqa: E402
 from scipy.spatial import cKDTree  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from plot_snapshots import (FIELDS, OUTLINE, GrainShape, InputError, colour_graph,  # noqa: E402
-                            palette_colours, read_run, read_snapshot, vertex_values)
+from plot_snapshots import (OUTLINE, GrainShape, InputError,  # noqa: E402
+                            add_colour_options, colour_graph, palette_colours, read_run,
+                            read_snapshot, vertex_values)
 
 AXES = "xyz"
 # In-plane (horizontal, vertical) axes of the slice normal to each axis: y stays up.
@@ -484,14 +485,7 @@ def main():
                        help="planes' positions [mm] (one, or one per --axis)")
     ap.add_argument("--thickness", type=float, default=None,
                     help="slab thickness [mm] (default: the median point spacing V^(1/3))")
-    ap.add_argument("--field", default="grain", choices=FIELDS,
-                    help="grain: distinct colours, neighbours never share one; pressure: grain "
-                    "pressure; point_pressure, J: per point")
-    ap.add_argument("--colours", type=int, default=8,
-                    help="palette size for --field grain (more are used only if the neighbour "
-                    "graph needs them)")
-    ap.add_argument("--range", type=float, nargs=2, default=(None, None), metavar=("LO", "HI"),
-                    help="ends of the colour scale (MPa for pressures), the same for every picture")
+    add_colour_options(ap, "the same for every picture")
     ap.add_argument("--elev", type=float, default=22.0, help="view: elevation [deg]")
     ap.add_argument("--azim", type=float, default=-58.0, help="view: azimuth [deg]")
     ap.add_argument("-o", "--output", default=None, help="default <folder>/snapshots")
