@@ -43,12 +43,20 @@ int add_box(mpm::Model<Dim>& m, const std::type_identity_t<Vec<Dim>>& lo,
   return m.add_grain(seeds, 0, 0.5 * h / ppc, v);
 }
 
+// Adds a disk (2D) or ball (3D) grain seeded on the lattice with ppc^Dim points per cell and
+// initial velocity v(x) [m/s].
+template <int Dim>
+int add_ball(mpm::Model<Dim>& m, const std::type_identity_t<Vec<Dim>>& c, double r, int ppc,
+             const std::type_identity_t<std::function<Vec<Dim>(const Vec<Dim>&)>>& v = {}) {
+  const double h = m.grid.cell_size();
+  auto seeds = points::seed_ball<Dim>(m.grid.origin(), h, ppc, c, r);
+  return m.add_grain(seeds, 0, 0.5 * h / ppc, v);
+}
+
 // Adds a disk grain seeded with ppc x ppc points per cell.
 inline int add_disk(mpm::Model<2>& m, const Vec<2>& c, double r, int ppc,
                     const std::function<Vec<2>(const Vec<2>&)>& v = {}) {
-  const double h = m.grid.cell_size();
-  auto seeds = points::seed_ball<2>(m.grid.origin(), h, ppc, c, r);
-  return m.add_grain(seeds, 0, 0.5 * h / ppc, v);
+  return add_ball<2>(m, c, r, ppc, v);
 }
 
 // All grid nodes (for kinematic drivers).

@@ -12,6 +12,7 @@
 #include <numbers>
 #include <vector>
 
+#include "../../support/builders.hpp"
 #include "../../support/drivers.hpp"
 #include "mpmcd/materials/law.hpp"
 #include "mpmcd/mpm/model.hpp"
@@ -23,30 +24,19 @@ using namespace mpmcd;
 
 namespace {
 
-// The paper's gel (method.md §3): Lamé coefficients [Pa], density [kg/m^3], P-wave speed [m/s].
-constexpr double kLambda = 3e6, kMu = 1.5e6, kRho = 990.0;
-const double kCp = std::sqrt((kLambda + 2 * kMu) / kRho);
+using test_support::kCp;
+using test_support::kLambda;
+using test_support::kMu;
+using test_support::kRho;
 
 // A 3D model on the grid [0, n h]^3 with the Neo-Hookean gel.
 mpm::Model<3> make_model(double h, int n) {
-  mpm::Model<3> m;
-  m.grid = grid::Grid<3>(Vec<3>::Zero(), h, IVec<3>(n, n, n));
-  m.add_material(materials::make_law<3>("neo_hookean", {{"lambda", kLambda}, {"mu", kMu}}), kRho);
-  return m;
+  return test_support::make_model<3>(h, IVec<3>(n, n, n), "neo_hookean", kLambda, kMu, kRho);
 }
 
-// A box grain [lo, hi] with ppc^3 points per cell.
-void add_box(mpm::Model<3>& m, const Vec<3>& lo, const Vec<3>& hi, int ppc) {
-  const double h = m.grid.cell_size();
-  m.add_grain(points::seed_box<3>(m.grid.origin(), h, ppc, lo, hi), 0, 0.5 * h / ppc, {});
-}
-
-// A ball grain with ppc^3 points per cell and initial velocity v(x) [m/s].
-void add_ball(mpm::Model<3>& m, const Vec<3>& c, double r, int ppc,
-              const std::function<Vec<3>(const Vec<3>&)>& v = {}) {
-  const double h = m.grid.cell_size();
-  m.add_grain(points::seed_ball<3>(m.grid.origin(), h, ppc, c, r), 0, 0.5 * h / ppc, v);
-}
+// A box grain [lo, hi] and a ball grain with ppc^3 points per cell (tests/support/builders.hpp).
+using test_support::add_ball;
+using test_support::add_box;
 
 // Cauchy stress of the compressible Neo-Hookean law in 3D (method.md §3) [Pa].
 Mat<3> closed_form_sigma(const Mat<3>& F) {
