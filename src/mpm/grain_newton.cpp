@@ -303,6 +303,7 @@ void newton_solve(GrainField<Dim>& w, const TrialState<Dim>& trial, const Settin
     dv2 += w.m[a] * dv.squaredNorm();
   }
   w.dv_norm = std::sqrt(dv2);
+  w.dv_from_contact = false;
   w.solved_once = true;
   ++w.solves;
 }

@@ -33,6 +33,7 @@ struct ImplicitSolver<Dim>::GrainWork : GrainField<Dim> {
     this->converged = false;
     this->solved_once = true;
     this->dv_norm = std::sqrt(dv2);
+    this->dv_from_contact = true;
   }
 };
 

@@ -152,6 +152,7 @@ struct GrainField {
   double res_norm = 0;              ///< |R| [N s]
   double res_ref = 0;               ///< reference scale of |R| [N s]
   double dv_norm = 0;               ///< |dv|_M of the last update [sqrt(kg) m/s]
+  bool dv_from_contact = false;     ///< that update was the response to an impulse change
   std::vector<double> history;      ///< |R| / reference per iteration [-]
   std::string failure;              ///< why the grain failed ("" if it did not)
   bool retryable = true;            ///< a smaller dt may cure the failure
