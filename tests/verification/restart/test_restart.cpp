@@ -7,12 +7,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -361,11 +364,72 @@ TEST(Restart, AFormat6CheckpointStillContinuesBitwise) {
       << mpmcd::test_support::read_file(src / "tiny_full.csv");
 }
 
+// The CSV rows of a run continued from an old checkpoint against the rows of the uninterrupted run
+// of the mpmcd that wrote it: the same header and rows, the rows up to the restart byte for byte,
+// the later ones with each field within `rel` of its column's largest magnitude (a solver change
+// since, such as a convergence test, moves them at the tolerance's level; a misread state moves
+// them far more). The solver's counters (iterations, solves, sweeps) are not compared.
+void expect_same_run(const fs::path& got, const fs::path& expected, int restart_step, double rel) {
+  const auto rows = [](const fs::path& f) {
+    std::vector<std::vector<std::string>> out;
+    std::istringstream in(mpmcd::test_support::read_file(f));
+    for (std::string line; std::getline(in, line);) {
+      out.emplace_back();
+      std::istringstream fields(line);
+      for (std::string v; std::getline(fields, v, ',');) out.back().push_back(v);
+    }
+    return out;
+  };
+  const auto a = rows(got), b = rows(expected);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_FALSE(b.empty());
+  ASSERT_EQ(a[0], b[0]) << "header";
+  const std::vector<std::string>& header = b[0];
+  for (std::size_t k = 0; k < header.size(); ++k) {
+    if (header[k] == "newton_iterations" || header[k] == "linear_solves" ||
+        header[k] == "gs_sweeps")
+      continue;
+    // Quantities that vanish by symmetry or by the energy balance are judged on the scale of the
+    // ones they come from.
+    static const std::map<std::string, std::vector<std::string>> siblings{
+        {"momentum_x", {"momentum_y"}},
+        {"lw_sxy", {"lw_sxx", "lw_syy"}},
+        {"energy_unaccounted", {"energy_change"}}};
+    std::vector<std::size_t> columns{k};
+    if (const auto it = siblings.find(header[k]); it != siblings.end())
+      for (const std::string& name : it->second)
+        columns.push_back(static_cast<std::size_t>(std::find(header.begin(), header.end(), name) -
+                                                   header.begin()));
+    double scale = 0;
+    for (std::size_t c : columns) {
+      ASSERT_LT(c, header.size()) << "no sibling column of " << header[k];
+      for (std::size_t r = 1; r < b.size(); ++r)
+        scale = std::max(scale, std::abs(std::stod(b[r][c])));
+    }
+    for (std::size_t r = 1; r < b.size(); ++r) {
+      if (static_cast<int>(r) - 1 <= restart_step) {
+        EXPECT_EQ(a[r][k], b[r][k]) << header[k] << ", row " << r;
+        continue;
+      }
+      const double x = std::stod(a[r][k]), y = std::stod(b[r][k]);
+      if (std::isnan(y)) {
+        EXPECT_TRUE(std::isnan(x)) << header[k] << ", row " << r;
+        continue;
+      }
+      EXPECT_LE(std::abs(x - y), rel * scale)
+          << header[k] << ", row " << r << ": " << x << " vs " << y;
+    }
+  }
+}
+
 // Checkpoint format 8 added the servo's integral (a 13th value per wall in /loading/wall); a
 // format 7 file with [loading] (written by the mpmcd before it, format7/: a block whose top wall
 // is a servo, stopped after step 10 of 30 in the middle of its ramp) is read with the integral 0
-// and continues the run to the same CSV bytes as that mpmcd's uninterrupted run.
-TEST(Restart, AFormat7CheckpointWithLoadingStillContinuesBitwise) {
+// and continues the run as that mpmcd's uninterrupted run did. Until 2026-11-26 to the same CSV
+// bytes; the convergence test of contact increments changed since (docs/contact.md, "Convergence
+// of the staggering"), which moves the later rows by up to 1e-9 of their columns' scale, so the
+// rows after the restart are compared to 1e-7 of it (expect_same_run).
+TEST(Restart, AFormat7CheckpointWithLoadingStillContinuesItsRun) {
   const fs::path src = fs::path(MPMCD_TEST_DIR) / "format7";
   const fs::path dir = scratch("format7");
   const fs::path ckpt = dir / "tiny_loading_checkpoint_000000010.h5";
@@ -379,8 +443,5 @@ TEST(Restart, AFormat7CheckpointWithLoadingStillContinuesBitwise) {
   EXPECT_EQ(s.loading_wall.size(), 4u * 12u);
   const int rc = run_binary({"run", "-q", "-t", "1", "--restart", ckpt.string()}, dir / "run.log");
   ASSERT_EQ(rc, 0) << mpmcd::test_support::read_file(dir / "run.log");
-  EXPECT_TRUE(mpmcd::test_support::read_file(dir / "tiny_loading.csv") ==
-              mpmcd::test_support::read_file(src / "tiny_loading_full.csv"))
-      << mpmcd::test_support::read_file(dir / "tiny_loading.csv") << "\nexpected\n"
-      << mpmcd::test_support::read_file(src / "tiny_loading_full.csv");
+  expect_same_run(dir / "tiny_loading.csv", src / "tiny_loading_full.csv", 10, 1e-7);
 }
