@@ -377,6 +377,8 @@ TEST(Coverage3D, OneBoxAndTwoOverlappingGrains) {
   add_block_3d(pts, 1, Vec<3>(1.3e-3, 0.75e-3, 0.5e-3), {30, 5, 10}, 1e-4);
   const auto two = domain_coverage(pts, box, voxel);
   const double face = 0.5e-3 * 1e-3;  // the y-z section of both grains
+  std::printf("  overlap %.6g (exact 1e-10), outside %.6g (1.5e-10), covered %.6g (1.75e-9) m^3\n",
+              two.overlap, two.outside, two.covered);
   EXPECT_NEAR(two.overlap, 0.2e-3 * face, voxel * face);
   EXPECT_NEAR(two.outside, 0.3e-3 * face, voxel * face);
   EXPECT_NEAR(two.covered, (4e-3 - 0.5e-3) * face, 2 * voxel * face);

@@ -216,6 +216,12 @@ TEST(ThreeDApp, CoverageAndGrainOutputs) {
   const double pore = csv["box_volume"].front() * (1 - csv["phi_geometric"].front());
   EXPECT_NEAR(csv["pore_diameter"].front(), std::cbrt(6 * pore / std::numbers::pi), 1e-9);
   EXPECT_GT(csv["phi_geometric"].back(), csv["phi_geometric"].front());
+  // The contact stress -(1/V) sym Σ F ⊗ ℓ against the grains' (the inertia term apart).
+  std::printf("  end: grain_syy %.5g Pa, contact_syy %.5g Pa, fabric_a %.3g (%g contacts)\n",
+              csv["grain_syy"].back(), csv["contact_syy"].back(), csv["fabric_a"].back(),
+              csv["fabric_contacts"].back());
+  EXPECT_NEAR(csv["contact_syy"].back() / csv["grain_syy"].back(), 1.0, 0.02);
+  EXPECT_EQ(csv["fabric_a"].back(), 2.5);  // one contact normal, along y: (5/2)(1 - 0)
   for (std::size_t k = 0; k < csv["time"].size(); ++k)
     for (const char* c : {"xx", "yy", "zz", "xy", "xz", "yz"}) {
       const double lw = csv[std::string("lw_s") + c][k];
