@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <numbers>
 #include <vector>
 
@@ -252,6 +253,18 @@ TEST(TimeSeries, ReadsColumnsAndRefusesGarbage) {
 
 namespace {
 
+// The pore diameter of pores of measures m_i: Σ m_i d_i / Σ m_i with the equivalent diameters
+// d_i = sqrt(4 m_i / π) (2D) or (6 m_i / π)^(1/3) (3D) [m].
+double weighted_diameter(std::initializer_list<double> measures, int dim) {
+  double weighted = 0, total = 0;
+  for (const double m : measures) {
+    weighted +=
+        m * (dim == 3 ? std::cbrt(6 * m / std::numbers::pi) : std::sqrt(4 * m / std::numbers::pi));
+    total += m;
+  }
+  return weighted / total;
+}
+
 // A grain: an nx x ny lattice of square point domains of side d with lower-left corner `origin`,
 // every point with the deformation gradient F about the grain's centre.
 void add_block(points::PointSet<2>& pts, std::int32_t g, const Vec<2>& origin, int nx, int ny,
@@ -322,9 +335,7 @@ TEST(Coverage, PoresBorderTwoGrainsOrAWallAndGapsOneGrain) {
       }
   const auto c = domain_coverage(pts, box, d / 16);
   const double a1 = 4e-8, a2 = 1e-8;
-  const double expected =
-      (a1 * std::sqrt(4 * a1 / std::numbers::pi) + a2 * std::sqrt(4 * a2 / std::numbers::pi)) /
-      (a1 + a2);
+  const double expected = weighted_diameter({a1, a2}, 2);
   EXPECT_NEAR(c.pore_diameter, expected, 1e-3 * expected);
   EXPECT_NEAR(c.pores, a1 + a2, 1e-12);
   EXPECT_NEAR(c.gaps, 1e-8, 1e-12);
@@ -424,9 +435,7 @@ TEST(Coverage3D, PoresBorderTwoGrainsOrAWallAndGapsOneGrain) {
   }
   const auto c = domain_coverage(pts, box, d / 8);
   const double v1 = 8e-12, v2 = 1e-12;
-  const double expected =
-      (v1 * std::cbrt(6 * v1 / std::numbers::pi) + v2 * std::cbrt(6 * v2 / std::numbers::pi)) /
-      (v1 + v2);
+  const double expected = weighted_diameter({v1, v2}, 3);
   EXPECT_NEAR(c.pore_diameter, expected, 1e-9 * expected);
   EXPECT_NEAR(c.pores, v1 + v2, 1e-9 * (v1 + v2));
   EXPECT_NEAR(c.gaps, 1e-12, 1e-9 * 1e-12);
