@@ -125,87 +125,117 @@ template double wall_normal_stress<3>(const Vec<3>&, const Vec<3>&, double);
 template Mat<2> love_weber_stress<2>(const points::PointSet<2>&, double);
 template Mat<3> love_weber_stress<3>(const points::PointSet<3>&, double);
 
-Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, double pixel,
-                         std::int64_t max_pixels) {
+namespace {
+
+// The coverage raster of domain_coverage in Dim dimensions (docs/observables.md, "Coverage"):
+// pixels (voxels) indexed k = i + n_x (j + n_y l), the voids 2 Dim-connected.
+template <int Dim>
+Coverage coverage_of(const points::PointSet<Dim>& points, const Box& box, double pixel,
+                     std::int64_t max_pixels) {
   const std::size_t n = points.size();
   // The domains' edges F D (columns) and the raster's extent: the box and every domain.
-  std::vector<Mat<2>> edges(n);
-  Vec<2> lo(box.x_min, box.y_min), hi(box.x_max, box.y_max);
+  std::vector<Mat<Dim>> edges(n);
+  Vec<Dim> box_lo, box_hi;
+  box_lo[0] = box.x_min, box_lo[1] = box.y_min, box_hi[0] = box.x_max, box_hi[1] = box.y_max;
+  if constexpr (Dim == 3) box_lo[2] = box.z_min, box_hi[2] = box.z_max;
+  Vec<Dim> lo = box_lo, hi = box_hi;
   for (std::size_t p = 0; p < n; ++p) {
     edges[p] = points.F[p] * points.domain[p];
-    const Vec<2> half = edges[p].cwiseAbs().rowwise().sum();  // half the bounding box
+    const Vec<Dim> half = edges[p].cwiseAbs().rowwise().sum();  // half the bounding box
     lo = lo.cwiseMin(points.x[p] - half);
     hi = hi.cwiseMax(points.x[p] + half);
   }
-  const Vec<2> extent = hi - lo;
-  pixel = std::max(pixel, std::sqrt(extent.prod() / static_cast<double>(max_pixels)));
-  std::int64_t nx = 0, ny = 0;
+  const Vec<Dim> extent = hi - lo;
+  const double per_pixel = extent.prod() / static_cast<double>(max_pixels);
+  pixel = std::max(pixel, Dim == 3 ? std::cbrt(per_pixel) : std::sqrt(per_pixel));
+  std::int64_t size[Dim], stride[Dim], total = 1;
   for (;; pixel *= 1.01) {  // the raster over the extent, at most max_pixels
-    nx = static_cast<std::int64_t>(std::ceil(extent[0] / pixel)) + 1;
-    ny = static_cast<std::int64_t>(std::ceil(extent[1] / pixel)) + 1;
-    if (nx * ny <= max_pixels) break;
+    total = 1;
+    for (int a = 0; a < Dim; ++a) {
+      size[a] = static_cast<std::int64_t>(std::ceil(extent[a] / pixel)) + 1;
+      stride[a] = total;
+      total *= size[a];
+    }
+    if (total <= max_pixels) break;
   }
-  std::vector<std::int32_t> last(static_cast<std::size_t>(nx * ny), -1);  // last grain seen
-  std::vector<std::uint16_t> grains(last.size(), 0);                      // grains covering
+  std::vector<std::int32_t> last(static_cast<std::size_t>(total), -1);  // last grain seen
+  std::vector<std::uint16_t> grains(last.size(), 0);                    // grains covering
   for (std::size_t p = 0; p < n; ++p) {
-    const Mat<2>& e = edges[p];
+    const Mat<Dim>& e = edges[p];
     const double det = e.determinant();
     if (!(std::fabs(det) > 0)) continue;
-    const Mat<2> inv = e.inverse();
-    const Vec<2> half = e.cwiseAbs().rowwise().sum();
-    const Vec<2> a = (points.x[p] - half - lo) / pixel, b = (points.x[p] + half - lo) / pixel;
+    const Mat<Dim> inv = e.inverse();
+    const Vec<Dim> half = e.cwiseAbs().rowwise().sum();
+    const Vec<Dim> a = (points.x[p] - half - lo) / pixel, b = (points.x[p] + half - lo) / pixel;
     // pixel i covers [lo + i pixel, lo + (i + 1) pixel): its centre lo + (i + 1/2) pixel
-    const auto i0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a[0] - 0.5)));
-    const auto i1 =
-        std::min<std::int64_t>(nx - 1, static_cast<std::int64_t>(std::floor(b[0] - 0.5)));
-    const auto j0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a[1] - 0.5)));
-    const auto j1 =
-        std::min<std::int64_t>(ny - 1, static_cast<std::int64_t>(std::floor(b[1] - 0.5)));
+    std::int64_t from[Dim], to[Dim], at[Dim];
+    bool empty = false;
+    for (int d = 0; d < Dim; ++d) {
+      from[d] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(a[d] - 0.5)));
+      to[d] =
+          std::min<std::int64_t>(size[d] - 1, static_cast<std::int64_t>(std::floor(b[d] - 0.5)));
+      at[d] = from[d];
+      empty = empty || from[d] > to[d];
+    }
+    if (empty) continue;
     const std::int32_t g = points.grain[p];
-    for (std::int64_t j = j0; j <= j1; ++j)
-      for (std::int64_t i = i0; i <= i1; ++i) {
-        const Vec<2> c =
-            lo + pixel * Vec<2>(static_cast<double>(i) + 0.5, static_cast<double>(j) + 0.5);
-        const Vec<2> s = inv * (c - points.x[p]);  // c = x_p + F D s
-        if (std::fabs(s[0]) > 1.0 || std::fabs(s[1]) > 1.0) continue;
-        const auto k = static_cast<std::size_t>(j * nx + i);
-        if (last[k] == g) continue;
-        last[k] = g;
-        if (grains[k] < std::numeric_limits<std::uint16_t>::max()) ++grains[k];
+    for (int d = 0; d < Dim;) {  // every pixel of the domain's bounding box, i fastest
+      Vec<Dim> c;
+      std::int64_t k = 0;
+      for (int q = 0; q < Dim; ++q) {
+        c[q] = static_cast<double>(at[q]) + 0.5;
+        k += at[q] * stride[q];
       }
+      c = lo + pixel * c;
+      const Vec<Dim> s = inv * (c - points.x[p]);  // c = x_p + F D s
+      bool in = true;
+      for (int q = 0; q < Dim; ++q) in = in && !(std::fabs(s[q]) > 1.0);
+      const auto kk = static_cast<std::size_t>(k);
+      if (in && last[kk] != g) {
+        last[kk] = g;
+        if (grains[kk] < std::numeric_limits<std::uint16_t>::max()) ++grains[kk];
+      }
+      for (d = 0; d < Dim && ++at[d] > to[d]; ++d) at[d] = from[d];  // the next pixel
+    }
   }
-  // Pixels whose centres lo + (i + 1/2) pixel lie in the box: i in [ib[0], ib[1]), j in
-  // [jb[0], jb[1]).
-  const auto first_inside = [&](double edge, double origin, std::int64_t n) {
-    return std::clamp<std::int64_t>(
-        static_cast<std::int64_t>(std::ceil((edge - origin) / pixel - 0.5)), 0, n);
+  // Pixels whose centres lo + (i + 1/2) pixel lie in the box: i in [inside[a][0], inside[a][1])
+  // along each axis a.
+  std::int64_t inside[Dim][2];
+  for (int d = 0; d < Dim; ++d)
+    for (int side = 0; side < 2; ++side)
+      inside[d][side] = std::clamp<std::int64_t>(
+          static_cast<std::int64_t>(std::ceil(((side ? box_hi : box_lo)[d] - lo[d]) / pixel - 0.5)),
+          0, size[d]);
+  const auto coords = [&](std::int64_t k, std::int64_t* c) {
+    for (int d = 0; d < Dim; ++d) c[d] = (k / stride[d]) % size[d];
   };
-  const std::int64_t ib[2] = {first_inside(box.x_min, lo[0], nx),
-                              first_inside(box.x_max, lo[0], nx)};
-  const std::int64_t jb[2] = {first_inside(box.y_min, lo[1], ny),
-                              first_inside(box.y_max, lo[1], ny)};
-  const auto in_box = [&](std::int64_t i, std::int64_t j) {
-    return i >= ib[0] && i < ib[1] && j >= jb[0] && j < jb[1];
+  const auto in_box = [&](const std::int64_t* c) {
+    for (int d = 0; d < Dim; ++d)
+      if (c[d] < inside[d][0] || c[d] >= inside[d][1]) return false;
+    return true;
   };
   Coverage out;
   out.pixel = pixel;
-  const double area = pixel * pixel;
-  std::int64_t inside = 0, beyond = 0, extra = 0;
-  for (std::int64_t j = 0; j < ny; ++j)
-    for (std::int64_t i = 0; i < nx; ++i) {
-      const auto count = grains[static_cast<std::size_t>(j * nx + i)];
-      if (count == 0) continue;
-      extra += count - 1;
-      ++(in_box(i, j) ? inside : beyond);
-    }
-  // Voids: the 4-connected components of uncovered pixels inside the box (flood fill, visited
-  // pixels marked last = -2). A void bordered by one grain only and not by a wall is a gap inside
-  // that grain (slivers of the seeding's tiling); the others are pores.
-  double weighted = 0, pore_area = 0, gap_area = 0;
+  const double measure = Dim == 3 ? pixel * pixel * pixel : pixel * pixel;
+  std::int64_t covered = 0, beyond = 0, extra = 0;
+  std::int64_t c[Dim];
+  for (std::int64_t k = 0; k < total; ++k) {
+    const auto count = grains[static_cast<std::size_t>(k)];
+    if (count == 0) continue;
+    extra += count - 1;
+    coords(k, c);
+    ++(in_box(c) ? covered : beyond);
+  }
+  // Voids: the 2 Dim-connected components of uncovered pixels inside the box (flood fill,
+  // visited pixels marked last = -2). A void bordered by one grain only and not by a wall is a
+  // gap inside that grain (slivers of the seeding's tiling); the others are pores.
+  double weighted = 0, pore_measure = 0, gap_measure = 0;
   std::vector<std::int64_t> stack;
-  for (std::int64_t start = 0; start < nx * ny; ++start) {
+  for (std::int64_t start = 0; start < total; ++start) {
     const auto s0 = static_cast<std::size_t>(start);
-    if (grains[s0] != 0 || last[s0] == -2 || !in_box(start % nx, start / nx)) continue;
+    if (grains[s0] != 0 || last[s0] == -2) continue;
+    coords(start, c);
+    if (!in_box(c)) continue;
     std::int64_t pixels = 0;
     std::int32_t first = -1;  // a grain bordering the void
     bool pore = false;        // bordered by two grains or by a wall
@@ -215,51 +245,73 @@ Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, doub
       const std::int64_t k = stack.back();
       stack.pop_back();
       ++pixels;
-      const std::int64_t i = k % nx, j = k / nx;
-      const std::int64_t next[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
-      for (const auto& [a, b] : next) {
-        if (a < 0 || b < 0 || a >= nx || b >= ny || !in_box(a, b)) {
-          pore = true;  // the void reaches a wall
-          continue;
+      coords(k, c);
+      for (int d = 0; d < Dim; ++d)
+        for (const std::int64_t step : {-1, 1}) {  // the neighbours -e_d, +e_d
+          c[d] += step;
+          const bool wall = !in_box(c);  // (outside the raster is outside the box)
+          c[d] -= step;
+          if (wall) {
+            pore = true;  // the void reaches a wall
+            continue;
+          }
+          const std::int64_t next = k + step * stride[d];
+          const auto q = static_cast<std::size_t>(next);
+          if (grains[q] != 0) {  // covered: last[q] is one of its grains
+            if (first < 0) first = last[q];
+            pore = pore || last[q] != first;
+            continue;
+          }
+          if (last[q] == -2) continue;
+          last[q] = -2;
+          stack.push_back(next);
         }
-        const auto q = static_cast<std::size_t>(b * nx + a);
-        if (grains[q] != 0) {  // covered: last[q] is one of its grains
-          if (first < 0) first = last[q];
-          pore = pore || last[q] != first;
-          continue;
-        }
-        if (last[q] == -2) continue;
-        last[q] = -2;
-        stack.push_back(b * nx + a);
-      }
     }
-    const double a = static_cast<double>(pixels) * area;
+    const double v = static_cast<double>(pixels) * measure;
     if (!pore) {
-      gap_area += a;
+      gap_measure += v;
       continue;
     }
-    weighted += a * std::sqrt(4 * a / std::numbers::pi);
-    pore_area += a;
+    // equivalent diameter: sqrt(4 A / π) of a disk, (6 V / π)^(1/3) of a sphere
+    weighted +=
+        v * (Dim == 3 ? std::cbrt(6 * v / std::numbers::pi) : std::sqrt(4 * v / std::numbers::pi));
+    pore_measure += v;
   }
-  out.pore_diameter = pore_area > 0 ? weighted / pore_area : 0.0;
-  out.pores = pore_area;
-  out.gaps = gap_area;
-  out.covered = static_cast<double>(inside) * area;
-  out.outside = static_cast<double>(beyond) * area;
-  out.overlap = static_cast<double>(extra) * area;
+  out.pore_diameter = pore_measure > 0 ? weighted / pore_measure : 0.0;
+  out.pores = pore_measure;
+  out.gaps = gap_measure;
+  out.covered = static_cast<double>(covered) * measure;
+  out.outside = static_cast<double>(beyond) * measure;
+  out.overlap = static_cast<double>(extra) * measure;
   return out;
+}
+
+}  // namespace
+
+Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, double pixel,
+                         std::int64_t max_pixels) {
+  return coverage_of<2>(points, box, pixel, max_pixels);
+}
+
+Coverage domain_coverage(const points::PointSet<3>& points, const Box& box, double voxel,
+                         std::int64_t max_voxels) {
+  return coverage_of<3>(points, box, voxel, max_voxels);
 }
 
 std::vector<ContactImpulse> contact_impulses(const contact::Problem<2>& problem) {
   return contact_impulses(problem, {});
 }
 
-std::vector<ContactImpulse> contact_impulses(
-    const contact::Problem<2>& problem, const std::function<Vec<2>(std::int64_t)>& node_position) {
-  std::vector<ContactImpulse> out;
+namespace {
+
+template <int Dim>
+std::vector<ContactImpulseOf<Dim>> impulses_of(
+    const contact::Problem<Dim>& problem,
+    const std::function<Vec<Dim>(std::int64_t)>& node_position) {
+  std::vector<ContactImpulseOf<Dim>> out;
   out.reserve(problem.contacts.size());
   for (const auto& c : problem.contacts) {
-    ContactImpulse ci;
+    ContactImpulseOf<Dim> ci;
     const auto& sb = problem.slots[static_cast<std::size_t>(c.b)];
     ci.a = c.a >= 0 ? problem.slots[static_cast<std::size_t>(c.a)].grain : -1 - c.wall;
     ci.b = sb.grain;
@@ -272,8 +324,9 @@ std::vector<ContactImpulse> contact_impulses(
   return out;
 }
 
-std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulse> contacts,
-                                       std::int64_t n_grains) {
+template <int Dim>
+std::vector<PairImpulse> pair_sums(std::span<const ContactImpulseOf<Dim>> contacts,
+                                   std::int64_t n_grains) {
   // Normal impulse summed per pair of bodies over all its contact nodes (walls: a < 0).
   std::map<std::pair<std::int32_t, std::int32_t>, double> sums;
   for (const auto& c : contacts) {
@@ -284,6 +337,28 @@ std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulse> contacts,
   out.reserve(sums.size());
   for (const auto& [key, p] : sums) out.push_back({key.first, key.second, p});
   return out;
+}
+
+}  // namespace
+
+std::vector<ContactImpulse> contact_impulses(
+    const contact::Problem<2>& problem, const std::function<Vec<2>(std::int64_t)>& node_position) {
+  return impulses_of<2>(problem, node_position);
+}
+
+std::vector<ContactImpulseOf<3>> contact_impulses(
+    const contact::Problem<3>& problem, const std::function<Vec<3>(std::int64_t)>& node_position) {
+  return impulses_of<3>(problem, node_position);
+}
+
+std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulse> contacts,
+                                       std::int64_t n_grains) {
+  return pair_sums<2>(contacts, n_grains);
+}
+
+std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulseOf<3>> contacts,
+                                       std::int64_t n_grains) {
+  return pair_sums<3>(contacts, n_grains);
 }
 
 double contact_threshold(std::span<const PairImpulse> pairs, const CoordinationSettings& settings) {

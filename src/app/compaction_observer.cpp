@@ -97,19 +97,21 @@ void CompactionObserver<Dim>::move_walls(const std::vector<walls::Wall<Dim>>& wa
 template <int Dim>
 std::string CompactionObserver<Dim>::csv_header() const {
   std::string h;
-  if (box_ && Dim == 3) {  // no coverage raster in 3D (docs/three_d.md)
+  if (box_ && Dim == 3) {
     h += ",h,width,depth,box_volume,eps,phi,Vs,ln_Vs_Vs0";
     for (const auto& w : config_.walls) h += ",wall_" + w.name + "_stress";
     if (mp_) h += ",sigma_bottom_over_Mp";
-    h += ",lw_sxx,lw_syy,lw_szz,lw_sxy,lw_sxz,lw_syz";
   } else if (box_) {
     h += ",h,width,box_area,eps,phi,Vs,ln_Vs_Vs0";
     for (const auto& w : config_.walls) h += ",wall_" + w.name + "_stress";
     if (mp_) h += ",sigma_bottom_over_Mp";
-    h += ",lw_sxx,lw_syy,lw_sxy,phi_geometric,overlap_over_Vs,outside_over_Vs,pore_diameter";
-  }  // without a box: Vs is the `volume` column already
+  }
+  if (box_)
+    h += symmetric_names<Dim>("lw_s") +
+         ",phi_geometric,overlap_over_Vs,outside_over_Vs,pore_diameter";
+  // without a box: Vs is the `volume` column already
   if (contact_) h += ",Z,Z_pairs,Z_grains,rattlers";
-  if (config_.output.grains && Dim == 2) h += grain_csv_header(contact_);
+  if (config_.output.grains) h += grain_csv_header<Dim>(contact_);
   return h;
 }
 
@@ -139,28 +141,19 @@ std::string CompactionObserver<Dim>::csv_fields(const mpm::Model<Dim>& model,
     }
     if (mp_) out += fmt::format(",{:.12e}", bottom / *mp_);
     const Mat<Dim> lw = analysis::love_weber_stress(model.points, box.area());
-    if constexpr (Dim == 3) {
-      out += fmt::format(",{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1),
-                         lw(2, 2), lw(0, 1), lw(0, 2), lw(1, 2));
-    } else {
-      out += fmt::format(",{:.12e},{:.12e},{:.12e}", lw(0, 0), lw(1, 1), lw(0, 1));
-      const auto c = analysis::domain_coverage(model.points, box, pixel_);
-      out += fmt::format(",{:.8e},{:.8e},{:.8e},{:.8e}", 1.0 - c.pores / box.area(), c.overlap / vs,
-                         c.outside / vs, c.pore_diameter);
-    }
+    out += symmetric_fields<Dim>(lw);
+    const auto c = analysis::domain_coverage(model.points, box, pixel_);
+    out += fmt::format(",{:.8e},{:.8e},{:.8e},{:.8e}", 1.0 - c.pores / box.area(), c.overlap / vs,
+                       c.outside / vs, c.pore_diameter);
   }
   if (contact_) {
     const auto z = coordination_of(problem, grains_);
     out += fmt::format(",{:.17g},{},{},{}", z.z, z.pairs, z.grains, z.rattlers);
   }
-  if constexpr (Dim == 2) {
-    if (config_.output.grains) {  // V: the box's area, else the grains' (docs/observables.md)
-      const GrainSnapshot snap = grain_snapshot(model, problem, false);
-      const double volume = box_ ? analysis::box_at(walls_, *box_, t).area() : grain_area(model);
-      out += grain_csv_fields(snap, volume, contact_);
-    }
-  } else {
-    (void)problem;
+  if (config_.output.grains) {  // V: the box's volume, else the grains' (docs/observables.md)
+    const auto snap = grain_snapshot(model, problem, false);
+    const double volume = box_ ? analysis::box_at(walls_, *box_, t).area() : grain_area(model);
+    out += grain_csv_fields(snap, volume, contact_);
   }
   return out;
 }

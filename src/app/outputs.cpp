@@ -242,17 +242,14 @@ void Outputs::csv_row(std::int64_t step, double t, double dt, const mpm::StepSta
 template <int Dim>
 void Outputs::vtu(const mpm::Model<Dim>& model, const mpm::ImplicitSolver<Dim>& solver,
                   const contact::Problem<Dim>& problem, double t) {
-  if constexpr (Dim == 2) {    // 3D inputs refuse [output] grains
-    if (cfg_.output.grains) {  // grain-scale files at every snapshot time, with or without VTU
-      const GrainSnapshot snap = grain_snapshot(model, problem);
-      const std::string gname =
-          fmt::format("{}_grains_{:06d}.csv", cfg_.simulation.name, vtu_count_);
-      write_grains_csv(model, snap, t, (fs::path(dir_) / gname).string());
-      if (solver.settings().contact.enabled) {
-        const std::string fname =
-            fmt::format("{}_forces_{:06d}.csv", cfg_.simulation.name, vtu_count_);
-        write_contact_forces_csv(snap, t, (fs::path(dir_) / fname).string());
-      }
+  if (cfg_.output.grains) {  // grain-scale files at every snapshot time, with or without VTU
+    const auto snap = grain_snapshot(model, problem);
+    const std::string gname = fmt::format("{}_grains_{:06d}.csv", cfg_.simulation.name, vtu_count_);
+    write_grains_csv(model, snap, t, (fs::path(dir_) / gname).string());
+    if (solver.settings().contact.enabled) {
+      const std::string fname =
+          fmt::format("{}_forces_{:06d}.csv", cfg_.simulation.name, vtu_count_);
+      write_contact_forces_csv(snap, t, (fs::path(dir_) / fname).string());
     }
   }
   if (!pvd_) {

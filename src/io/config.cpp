@@ -81,8 +81,7 @@ Schema build_schema() {
   s.add_table(&Config::simulation,
               "Global settings. `dimension = 2` is plane strain (grains are disks, rectangles or "
               "packings of disks); `dimension = 3` is 3D (grains are spheres, boxes or packings of "
-              "spheres; docs/three_d.md lists what 3D does not have yet: `[output] grains`, the "
-              "coverage columns).",
+              "spheres; docs/three_d.md lists what 3D does not have yet).",
               {KeySpec::string("name", &SimulationSection::name,
                                "run name used in output file names (letters, digits, `_ - .`)")
                    .nonempty()
@@ -562,7 +561,7 @@ Schema build_schema() {
                         "grain-scale outputs: `<name>_grains_<n>.csv` (per-grain stress, shape, "
                         "contacts) and `<name>_forces_<n>.csv` (contact forces per pair) at every "
                         "snapshot time (vtu_interval), fabric and stress columns in the CSV "
-                        "(docs/observables.md); 2D only")
+                        "(docs/observables.md); in 3D with full symmetric tensors")
            .default_of_member()});
 
   s.add_table(

@@ -62,14 +62,7 @@ class ConfigReader {
     read_walls(r, c);
     read_loading(r, c);
     read_stop(r, c);
-    {
-      const TableReader out = r.sub(&Config::output);
-      out.fill(c.output);
-      if (dim_ == 3 && c.output.grains)
-        out.fail(&OutputSection::grains,
-                 "the grain-scale outputs are 2D only for now (docs/three_d.md): set grains = "
-                 "false in 3D");
-    }
+    r.sub(&Config::output).fill(c.output);
     r.sub(&Config::checkpoint).fill(c.checkpoint);
     return c;
   }

@@ -5,7 +5,7 @@
 /// network and the volume-averaged (Love-Weber) stress of the grains. Pure functions on plain data.
 /// The box, Φ, ε, the wall stresses and the Love-Weber stress are given in 2D and 3D (a 3D box has
 /// two more walls, normals ±z; the height stays along y), and Z from pair_impulses of a 3D
-/// contact problem; the coverage and the per-contact ContactImpulse are 2D.
+/// contact problem; the coverage (pixels in 2D, voxels in 3D) and the per-contact impulses too.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -92,22 +92,24 @@ extern template Mat<2> love_weber_stress<2>(const points::PointSet<2>&, double);
 extern template Mat<3> love_weber_stress<3>(const points::PointSet<3>&, double);
 
 /// How the point domains cover the box (docs/observables.md, "Coverage"): each point's domain is
-/// the parallelogram x_p + F_p D_p s, s ∈ [-1, 1]² (D_p its reference half-edge vectors, the
-/// CPDI domain), rasterised on square pixels whose centres are tested.
+/// the parallelogram (3D: parallelepiped) x_p + F_p D_p s, s ∈ [-1, 1]^Dim (D_p its reference
+/// half-edge vectors, the CPDI domain; uGIMP's square D_p = l_p I alike), rasterised on square
+/// pixels (3D: cubic voxels) whose centres are tested. Measures are areas [m^2] in 2D, volumes
+/// [m^3] in 3D.
 struct Coverage {
-  double covered = 0;  ///< area inside the box covered by at least one domain [m^2]
-  double overlap = 0;  ///< area covered by two or more grains, counted (grains − 1) times [m^2]
-  double outside = 0;  ///< area outside the box covered by at least one domain [m^2]
-  /// Area of the pores: the void regions inside the box (4-connected uncovered pixels) that
-  /// border two grains or a wall [m^2].
+  double covered = 0;  ///< measure inside the box covered by at least one domain [m^2 | m^3]
+  double overlap = 0;  ///< measure covered by two or more grains, counted (grains − 1) times
+  double outside = 0;  ///< measure outside the box covered by at least one domain [m^2 | m^3]
+  /// Measure of the pores: the void regions inside the box (4-connected uncovered pixels, 3D:
+  /// 6-connected voxels) that border two grains or a wall [m^2 | m^3].
   double pores = 0;
-  /// Area of the void regions bordered by one grain only: gaps of that grain's domain tiling
-  /// (e.g. the slivers between polar seeding's rectangles), solid for Φ [m^2].
+  /// Measure of the void regions bordered by one grain only: gaps of that grain's domain tiling
+  /// (e.g. the slivers between polar seeding's rectangles), solid for Φ [m^2 | m^3].
   double gaps = 0;
-  /// Pore size: mean equivalent diameter sqrt(4 A_i / π) of the pores, weighted by their areas
-  /// A_i [m]; 0 without pores.
+  /// Pore size: mean equivalent diameter of the pores, sqrt(4 A_i / π) in 2D, (6 V_i / π)^(1/3)
+  /// in 3D, weighted by their measures A_i, V_i [m]; 0 without pores.
   double pore_diameter = 0;
-  double pixel = 0;  ///< side of the pixels used [m]
+  double pixel = 0;  ///< side of the pixels (voxels) used [m]
 };
 
 /// The coverage of the box by the point domains, on pixels of side `pixel` [m] (enlarged so that
@@ -115,16 +117,23 @@ struct Coverage {
 /// must be contiguous (points::PointSet); overlaps of domains of one grain are not counted.
 Coverage domain_coverage(const points::PointSet<2>& points, const Box& box, double pixel,
                          std::int64_t max_pixels = std::int64_t{1} << 24);
+/// The same in 3D on cubic voxels of side `voxel` [m] (at most `max_voxels` of them), the voids
+/// 6-connected.
+Coverage domain_coverage(const points::PointSet<3>& points, const Box& box, double voxel,
+                         std::int64_t max_voxels = std::int64_t{1} << 24);
 
-/// One grid-node contact reduced to what Z and the contact forces need.
-struct ContactImpulse {
-  std::int32_t a = -1;               ///< grain A, or -1 - k for wall k [-]
-  std::int32_t b = -1;               ///< grain B [-]
-  double normal_impulse = 0;         ///< P·n, positive in compression [N s/m]
-  Vec<2> impulse = Vec<2>::Zero();   ///< P, impulse of A on B over the step [N s/m]
-  Vec<2> normal = Vec<2>::Zero();    ///< unit normal from A to B [-]
-  Vec<2> position = Vec<2>::Zero();  ///< position of the contact's grid node [m]
+/// One grid-node contact reduced to what Z and the contact forces need (Dim = 2 or 3).
+template <int Dim>
+struct ContactImpulseOf {
+  std::int32_t a = -1;                   ///< grain A, or -1 - k for wall k [-]
+  std::int32_t b = -1;                   ///< grain B [-]
+  double normal_impulse = 0;             ///< P·n, positive in compression [N s/m | N s]
+  Vec<Dim> impulse = Vec<Dim>::Zero();   ///< P, impulse of A on B over the step [N s/m | N s]
+  Vec<Dim> normal = Vec<Dim>::Zero();    ///< unit normal from A to B [-]
+  Vec<Dim> position = Vec<Dim>::Zero();  ///< position of the contact's grid node [m]
 };
+/// The 2D contact impulse (per unit thickness).
+using ContactImpulse = ContactImpulseOf<2>;
 
 /// The contacts of a solved contact problem: grains of the two slots (a = -1 - k for wall k),
 /// P·n, P and n (position left 0).
@@ -133,6 +142,9 @@ std::vector<ContactImpulse> contact_impulses(const contact::Problem<2>& problem)
 /// The same with each contact's position: node_position(slot node index) [m].
 std::vector<ContactImpulse> contact_impulses(
     const contact::Problem<2>& problem, const std::function<Vec<2>(std::int64_t)>& node_position);
+/// The same in 3D.
+std::vector<ContactImpulseOf<3>> contact_impulses(
+    const contact::Problem<3>& problem, const std::function<Vec<3>(std::int64_t)>& node_position);
 
 /// Settings of the coordination number.
 struct CoordinationSettings {
@@ -155,6 +167,9 @@ struct PairImpulse {
 /// Normal impulses summed per pair of bodies (grains (min, max), walls (-1 - k, grain)), sorted
 /// by (a, b); contacts naming a grain outside [0, n_grains) or a grain with itself are skipped.
 std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulse> contacts,
+                                       std::int64_t n_grains);
+/// The same for 3D contacts.
+std::vector<PairImpulse> pair_impulses(std::span<const ContactImpulseOf<3>> contacts,
                                        std::int64_t n_grains);
 
 /// The same straight from a solved contact problem of any dimension: P·n of each contact

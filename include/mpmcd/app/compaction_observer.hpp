@@ -5,7 +5,8 @@
 /// and the [stop] criteria. Wires analysis/ to the model and the solver; used by run_simulation.
 /// In 3D (six walls, normals ±x, ±y, ±z) the box columns are h, width, depth, the box volume, ε,
 /// Φ, Vs, ln(Vs/Vs0), the wall stresses (force over face area) and the six Love-Weber
-/// components, and Z (from the per-pair normal impulses); the coverage is 2D only.
+/// components, the coverage on cubic voxels of side h/8, and Z (from the per-pair normal
+/// impulses); `[output] grains` adds the grain-scale columns in 2D and 3D.
 #include <optional>
 #include <string>
 #include <vector>
@@ -96,7 +97,7 @@ class CompactionObserver {
   std::optional<double> mp_;
   bool contact_ = false;
   std::int64_t grains_ = 0;
-  double pixel_ = 0;  ///< pixel of the coverage raster, h/8 [m]
+  double pixel_ = 0;  ///< pixel (3D: voxel) side of the coverage raster, h/8 [m]
 };
 
 /// Deduces the dimension from the model.

@@ -327,3 +327,101 @@ TEST_F(KnownPacking, ContactStress) {
   EXPECT_DOUBLE_EQ(m(1, 1), -0.4);
   EXPECT_DOUBLE_EQ(m(0, 1), 0.3);
 }
+
+// 3D (issue 18): a box grain of 4 x 2 x 1 lattice cubes (side d) under two stresses: its volume,
+// centroid and volume-averaged stress, the second moment of a box of half-extents a, b, c
+// (V/3 diag(a², b², c²), the lattice terms plus each cube's own moment: exact) and its aspect
+// ratio a/c; the 3D invariants.
+TEST(GrainState3D, BoxGrainMomentStressAndInvariants) {
+  const double d = 1e-3;
+  points::PointSet<3> p;
+  for (int k = 0; k < 1; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 4; ++i)
+        p.add(Vec<3>((i + 0.5) * d, (j + 0.5) * d, (k + 0.5) * d), Vec<3>::Zero(), 1.0, d * d * d,
+              Mat<3>::Identity() * (0.5 * d), 0);
+  for (std::size_t q = 0; q < p.size(); ++q)
+    p.sigma[q] =
+        q < 4 ? Mat<3>(Vec<3>(-1, -2, -3).asDiagonal()) : Mat<3>(Vec<3>(-3, -2, -1).asDiagonal());
+  p.sigma[0](0, 2) = p.sigma[0](2, 0) = 4;  // σxz of one point: 4/8 on average
+  const std::vector<points::Grain> grains = {points::Grain{0, 8}};
+  const auto states = grain_states(p, grains);
+  ASSERT_EQ(states.size(), 1u);
+  const GrainStateOf<3>& g = states[0];
+  EXPECT_DOUBLE_EQ(g.area, 8 * d * d * d);
+  EXPECT_NEAR(g.centroid[0], 2 * d, 1e-18);
+  EXPECT_NEAR(g.centroid[1], d, 1e-18);
+  EXPECT_NEAR(g.centroid[2], 0.5 * d, 1e-18);
+  EXPECT_DOUBLE_EQ(g.stress(0, 0), -2);
+  EXPECT_DOUBLE_EQ(g.stress(2, 2), -2);
+  EXPECT_DOUBLE_EQ(g.stress(0, 2), 0.5);
+  const double V = 8 * d * d * d, a = 2 * d, b = d, c = 0.5 * d;
+  EXPECT_NEAR(g.moment(0, 0), V / 3 * a * a, 1e-12 * V * a * a);
+  EXPECT_NEAR(g.moment(1, 1), V / 3 * b * b, 1e-12 * V * a * a);
+  EXPECT_NEAR(g.moment(2, 2), V / 3 * c * c, 1e-12 * V * a * a);
+  EXPECT_NEAR(g.moment(0, 1), 0.0, 1e-12 * V * a * a);
+  EXPECT_NEAR(aspect_ratio(g.moment), a / c, 1e-9);
+  // σ = diag(-2, -2, -2) + 0.5 (e_x⊗e_z + e_z⊗e_x): σ_m = -2, |s| = sqrt(2 · 0.25).
+  EXPECT_DOUBLE_EQ(mean_stress(g.stress), -2.0);
+  EXPECT_NEAR(deviator_norm(g.stress), std::sqrt(0.5), 1e-15);
+}
+
+// 3D pairs: the force of a contact named (b, a) reversed, the tangential force |F - f_n n|; the
+// fabric of normals along ±x, ±y, ±z equally (R = I/3, a = 0) and of normals along y only
+// (R_1 = 1: a = (5/2)(1 - 0)); the contact stress σ_c = -(1/V) Σ F ⊗ ℓ and the mean grain
+// stress in 3D.
+TEST(PairForces3D, TangentialForceFabricAndStresses) {
+  std::vector<GrainStateOf<3>> g(3);
+  g[0].centroid = Vec<3>(0, 0, 0);
+  g[1].centroid = Vec<3>(0, 2, 0);
+  g[2].centroid = Vec<3>(0, 0, 2);
+  for (auto& s : g) s.area = 1;
+  std::vector<ContactImpulseOf<3>> c(3);
+  const auto set = [&](ContactImpulseOf<3>& ci, int a, int b, const Vec<3>& P, const Vec<3>& n) {
+    ci.a = a;
+    ci.b = b;
+    ci.impulse = P;
+    ci.normal = n;
+    ci.normal_impulse = P.dot(n);
+  };
+  set(c[0], 0, 1, Vec<3>(0.3, 2, 0.4), Vec<3>(0, 1, 0));  // 0 on 1
+  set(c[1], 2, 0, Vec<3>(0, 0, -3), Vec<3>(0, 0, -1));    // 2 on 0: stored as 0 on 2
+  set(c[2], -1, 0, Vec<3>(0, 5, 0), Vec<3>(0, 1, 0));     // wall 0 on grain 0
+  c[2].position = Vec<3>(0, -1, 0);
+  const auto pairs = pair_forces(c, 0.5, g);  // F = P / 0.5
+  ASSERT_EQ(pairs.size(), 3u);
+  EXPECT_EQ(pairs[1].a, 0);
+  EXPECT_EQ(pairs[1].b, 1);
+  EXPECT_DOUBLE_EQ(pairs[1].normal_force, 4.0);
+  EXPECT_DOUBLE_EQ(pairs[1].tangential_force, 1.0);  // |(0.6, 0, 0.8)|
+  EXPECT_EQ(pairs[2].b, 2);
+  EXPECT_DOUBLE_EQ(pairs[2].force[2], 6.0);  // reversed: 0 on 2 along +z
+  EXPECT_DOUBLE_EQ(pairs[2].normal[2], 1.0);
+  EXPECT_DOUBLE_EQ(pairs[2].tangential_force, 0.0);
+  // σ_c = -(1/V) sym Σ F ⊗ ℓ: (0.6, 4, 0.8)⊗(0, 2, 0), (0, 0, 6)⊗(0, 0, 2), wall (0, 10, 0)⊗
+  // (0, 1, 0); V = 4.
+  const Mat<3> s = contact_stress(pairs, 4.0);
+  EXPECT_DOUBLE_EQ(s(1, 1), -(8 + 10) / 4.0);
+  EXPECT_DOUBLE_EQ(s(2, 2), -12 / 4.0);
+  EXPECT_DOUBLE_EQ(s(0, 1), -0.6 / 4.0);
+  EXPECT_DOUBLE_EQ(s(1, 2), -0.8 / 4.0);
+  g[0].stress = Mat<3>::Identity();
+  g[1].stress = 3 * Mat<3>::Identity();
+  EXPECT_DOUBLE_EQ(mean_grain_stress(g, 4.0)(2, 2), 1.0);
+
+  std::vector<PairForceOf<3>> iso(3);
+  for (int k = 0; k < 3; ++k) {
+    iso[k].a = 0;
+    iso[k].b = k + 1;
+    iso[k].in_contact = true;
+    iso[k].normal = Vec<3>::Unit(k);
+  }
+  const FabricOf<3> f = fabric(iso);
+  EXPECT_EQ(f.contacts, 3);
+  EXPECT_NEAR(f.tensor(1, 1), 1.0 / 3, 1e-15);
+  EXPECT_NEAR(f.anisotropy, 0.0, 1e-15);
+  for (auto& p : iso) p.normal = Vec<3>::UnitY();
+  EXPECT_NEAR(fabric(iso).anisotropy, 2.5, 1e-15);
+  const std::vector<std::uint8_t> kept = {1, 1, 0, 0};  // only pair 0-1 between kept grains
+  EXPECT_EQ(fabric(iso, kept).contacts, 1);
+}

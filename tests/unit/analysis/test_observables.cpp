@@ -2,9 +2,13 @@
 // paper eq. (9), wall stress, Love-Weber stress of a uniform state, coordination number Z.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <numbers>
 #include <vector>
 
@@ -249,6 +253,18 @@ TEST(TimeSeries, ReadsColumnsAndRefusesGarbage) {
 
 namespace {
 
+// The pore diameter of pores of measures m_i: Σ m_i d_i / Σ m_i with the equivalent diameters
+// d_i = sqrt(4 m_i / π) (2D) or (6 m_i / π)^(1/3) (3D) [m].
+double weighted_diameter(std::initializer_list<double> measures, int dim) {
+  double weighted = 0, total = 0;
+  for (const double m : measures) {
+    weighted +=
+        m * (dim == 3 ? std::cbrt(6 * m / std::numbers::pi) : std::sqrt(4 * m / std::numbers::pi));
+    total += m;
+  }
+  return weighted / total;
+}
+
 // A grain: an nx x ny lattice of square point domains of side d with lower-left corner `origin`,
 // every point with the deformation gradient F about the grain's centre.
 void add_block(points::PointSet<2>& pts, std::int32_t g, const Vec<2>& origin, int nx, int ny,
@@ -319,11 +335,111 @@ TEST(Coverage, PoresBorderTwoGrainsOrAWallAndGapsOneGrain) {
       }
   const auto c = domain_coverage(pts, box, d / 16);
   const double a1 = 4e-8, a2 = 1e-8;
-  const double expected =
-      (a1 * std::sqrt(4 * a1 / std::numbers::pi) + a2 * std::sqrt(4 * a2 / std::numbers::pi)) /
-      (a1 + a2);
+  const double expected = weighted_diameter({a1, a2}, 2);
   EXPECT_NEAR(c.pore_diameter, expected, 1e-3 * expected);
   EXPECT_NEAR(c.pores, a1 + a2, 1e-12);
   EXPECT_NEAR(c.gaps, 1e-8, 1e-12);
   EXPECT_NEAR(c.covered, 1e-6 - a1 - 2 * a2, 1e-12);
+}
+
+namespace {
+
+// A 3D grain: an n[0] x n[1] x n[2] lattice of cubic point domains of side d with lowest corner
+// `origin`, every point with the deformation gradient F about the grain's centre; the points
+// listed in `skip` (lattice indices i, j, k) left out.
+void add_block_3d(points::PointSet<3>& pts, std::int32_t g, const Vec<3>& origin,
+                  const std::array<int, 3>& n, double d, const Mat<3>& F = Mat<3>::Identity(),
+                  const std::vector<std::array<int, 3>>& skip = {}) {
+  const Vec<3> centre = origin + 0.5 * d * Vec<3>(n[0], n[1], n[2]);
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        if (std::find(skip.begin(), skip.end(), std::array<int, 3>{i, j, k}) != skip.end())
+          continue;
+        const Vec<3> x0 = origin + d * Vec<3>(i + 0.5, j + 0.5, k + 0.5);
+        pts.add(centre + F * (x0 - centre), Vec<3>::Zero(), 1.0, d * d * d,
+                Mat<3>::Identity() * (0.5 * d), g);
+        pts.F.back() = F;
+      }
+}
+
+}  // namespace
+
+// One box-shaped domain whose faces lie on voxel faces: its volume to round-off, nothing outside
+// or overlapping; a second grain overlapping it over a slab and crossing the right wall: the
+// slab's volume as overlap, the part past the wall as outside (within one voxel layer).
+TEST(Coverage3D, OneBoxAndTwoOverlappingGrains) {
+  const Box box{0, 4e-3, 0, 2e-3, 0, 2e-3, 3};
+  points::PointSet<3> pts;
+  pts.add(Vec<3>(1e-3, 1e-3, 1e-3), Vec<3>::Zero(), 1.0, 0.5e-9,
+          Vec<3>(0.5e-3, 0.25e-3, 0.5e-3).asDiagonal().toDenseMatrix(), 0);  // 1 x 0.5 x 1 mm
+  const double voxel = 1e-3 / 32;
+  const auto one = domain_coverage(pts, box, voxel);
+  EXPECT_DOUBLE_EQ(one.pixel, voxel);
+  EXPECT_NEAR(one.covered, 0.5e-9, 1e-12 * 0.5e-9);
+  EXPECT_EQ(one.overlap, 0.0);
+  EXPECT_EQ(one.outside, 0.0);
+  // Pores: the box less the domain, one void reaching the walls.
+  EXPECT_NEAR(one.pores, 16e-9 - 0.5e-9, 1e-12 * 16e-9);
+  EXPECT_NEAR(one.pore_diameter, std::cbrt(6 * 15.5e-9 / std::numbers::pi), 1e-12);
+
+  // Grain 1: x from 1.3 to 4.3 mm (over grain 0's x <= 1.5 mm: a 0.2 mm slab), y and z as
+  // grain 0's domain.
+  add_block_3d(pts, 1, Vec<3>(1.3e-3, 0.75e-3, 0.5e-3), {30, 5, 10}, 1e-4);
+  const auto two = domain_coverage(pts, box, voxel);
+  const double face = 0.5e-3 * 1e-3;  // the y-z section of both grains
+  std::printf("  overlap %.6g (exact 1e-10), outside %.6g (1.5e-10), covered %.6g (1.75e-9) m^3\n",
+              two.overlap, two.outside, two.covered);
+  EXPECT_NEAR(two.overlap, 0.2e-3 * face, voxel * face);
+  EXPECT_NEAR(two.outside, 0.3e-3 * face, voxel * face);
+  EXPECT_NEAR(two.covered, (4e-3 - 0.5e-3) * face, 2 * voxel * face);
+}
+
+// Parallelepipeds: a sheared and stretched lattice (F, J = det F) tiles without gaps or overlaps,
+// so its covered volume is J times the undeformed one; a raster limited to 1e5 voxels coarsens
+// them and still measures it.
+TEST(Coverage3D, ParallelepipedsFollowTheDeformationGradient) {
+  const Box box{0, 3e-3, 0, 3e-3, 0, 3e-3, 3};
+  Mat<3> F;
+  F << 1.2, 0.3, -0.1, 0.05, 0.8, 0.2, -0.2, 0.1, 1.1;
+  points::PointSet<3> pts;
+  add_block_3d(pts, 0, Vec<3>(1e-3, 1e-3, 1e-3), {10, 10, 10}, 1e-4, F);
+  const auto c = domain_coverage(pts, box, 1e-4 / 4);
+  std::printf("  J = %.6f, covered / V0 = %.6f\n", F.determinant(), c.covered / 1e-9);
+  EXPECT_NEAR(c.covered / 1e-9, F.determinant(), 0.01);
+  EXPECT_EQ(c.overlap, 0.0);  // overlaps within a grain are not counted
+  EXPECT_EQ(c.outside, 0.0);
+  const auto coarse = domain_coverage(pts, box, 1e-4 / 4, 100000);
+  EXPECT_GT(coarse.pixel, 3e-3 / 47);  // 47^3 > 1e5 voxels over the box alone
+  EXPECT_NEAR(coarse.covered / 1e-9, F.determinant(), 0.05);
+  std::printf("  coarse: voxel %.4g m, covered / V0 = %.6f\n", coarse.pixel, coarse.covered / 1e-9);
+}
+
+// A 1 mm cube filled by two grains (x < 0.5 mm and x > 0.5 mm) less a 0.2 mm cubic hole across
+// both (enclosed between the grains: a pore), a 0.1 mm hole in grain 1 on the right wall (a
+// pore) and a 0.1 mm hole enclosed in grain 0 (a gap). The voids are 6-connected; the pore
+// diameter is (V1 d1 + V2 d2) / (V1 + V2), d_i = (6 V_i / π)^(1/3).
+TEST(Coverage3D, PoresBorderTwoGrainsOrAWallAndGapsOneGrain) {
+  const Box box{0, 1e-3, 0, 1e-3, 0, 1e-3, 3};
+  const double d = 1e-4;
+  std::vector<std::array<int, 3>> holes = {{9, 7, 5}, {1, 7, 5}};
+  for (int i = 4; i < 6; ++i)
+    for (int j = 2; j < 4; ++j)
+      for (int k = 2; k < 4; ++k) holes.push_back({i, j, k});
+  points::PointSet<3> pts;
+  for (int g = 0; g < 2; ++g) {
+    std::vector<std::array<int, 3>> skip;  // the holes in this grain's own lattice indices
+    for (const auto& h : holes)
+      if (h[0] >= 5 * g && h[0] < 5 * g + 5) skip.push_back({h[0] - 5 * g, h[1], h[2]});
+    add_block_3d(pts, g, Vec<3>(5 * g * d, 0, 0), {5, 10, 10}, d, Mat<3>::Identity(), skip);
+  }
+  const auto c = domain_coverage(pts, box, d / 8);
+  const double v1 = 8e-12, v2 = 1e-12;
+  const double expected = weighted_diameter({v1, v2}, 3);
+  EXPECT_NEAR(c.pore_diameter, expected, 1e-9 * expected);
+  EXPECT_NEAR(c.pores, v1 + v2, 1e-9 * (v1 + v2));
+  EXPECT_NEAR(c.gaps, 1e-12, 1e-9 * 1e-12);
+  EXPECT_NEAR(c.covered, 1e-9 - v1 - 2 * v2, 1e-9 * 1e-9);
+  EXPECT_EQ(c.overlap, 0.0);
+  EXPECT_EQ(c.outside, 0.0);
 }

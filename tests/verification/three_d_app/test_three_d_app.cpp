@@ -1,11 +1,14 @@
 // 3D through the command line (issue 18): `mpmcd run` of TOML inputs with `dimension = 3`. A
 // sphere resting on a wall carries its weight; a sphere squeezed in a box of six walls ([loading])
 // has the exact initial Φ and, stopped half way and restarted from its checkpoint, ends with the
-// same bytes in every output; 3D inputs with the wrong number of components, or 2D-only shapes
-// and keys, are refused with exit 2 and a message naming the file, the key and what was expected.
+// same bytes in every output, and with `[output] grains` writes the coverage and grain-scale
+// outputs consistently with its Love-Weber stress and wall forces; 3D inputs with the wrong
+// number of components, or 2D-only shapes and keys, are refused with exit 2 and a message naming
+// the file, the key and what was expected.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -61,6 +64,36 @@ std::map<std::string, std::vector<double>> read_csv(const fs::path& path) {
   return cols;
 }
 
+// Two spheres (R = 1 mm) stacked along y in a box of six walls, the top one (normal -y) moving
+// down at 0.5 m/s for 40 steps of 2e-5 s; `output` is the body of its [output] table.
+std::string squeeze_input(const std::string& name, const std::string& output) {
+  std::string walls;
+  const char* names[6] = {"left", "right", "bottom", "top", "front", "back"};
+  const double at[6] = {0.001, 0.003, 0.001, 0.0051, 0.0009, 0.0031};
+  for (int k = 0; k < 6; ++k) {
+    double n[3] = {0, 0, 0}, x[3] = {0, 0, 0};
+    n[k / 2] = k % 2 == 0 ? 1.0 : -1.0;
+    x[k / 2] = at[k];
+    std::ostringstream w;
+    w << "[[walls]]\nname = \"" << names[k] << "\"\npoint = [" << x[0] << ", " << x[1] << ", "
+      << x[2] << "]\nnormal = [" << n[0] << ", " << n[1] << ", " << n[2] << "]\n";
+    walls += w.str();
+  }
+  return "[simulation]\nname = \"" + name + "\"\ndimension = 3\n" +
+         "[grid]\norigin = [0.0, 0.0, 0.0]\nextent = [0.004, 0.006, 0.004]\ncell_size = 0.0005\n"
+         "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\nlambda = 3e6\n"
+         "mu = 1.5e6\n"
+         "[[grains]]\nshape = \"sphere\"\nmaterial = \"gel\"\ncenter = [0.002, 0.002, 0.002]\n"
+         "radius = 0.001\n"
+         "[[grains]]\nshape = \"sphere\"\nmaterial = \"gel\"\ncenter = [0.002, 0.004, 0.002]\n"
+         "radius = 0.001\n" +
+         walls +
+         "[loading]\n[[loading.stages]]\nname = \"squeeze\"\n[[loading.stages.walls]]\n"
+         "name = \"top\"\nvelocity = [0.0, -0.5, 0.0]\n"
+         "[time]\ndt = 2e-5\nend_time = 0.0008\n[output]\n" +
+         output;
+}
+
 }  // namespace
 
 // A sphere set on a frictionless floor (normal +z) under gravity, 389 steps of 2h/c_p (as
@@ -104,32 +137,8 @@ TEST(ThreeDApp, SphereRestingOnAWallCarriesItsWeight) {
 // ends with the same CSV, VTU, PVD and pair files and the same final checkpoint, byte for byte.
 TEST(ThreeDApp, SqueezedSpheresRestartBitwise) {
   const fs::path dir = scratch("squeeze");
-  std::string walls;
-  const char* names[6] = {"left", "right", "bottom", "top", "front", "back"};
-  const double at[6] = {0.001, 0.003, 0.001, 0.0051, 0.0009, 0.0031};
-  for (int k = 0; k < 6; ++k) {
-    double n[3] = {0, 0, 0}, x[3] = {0, 0, 0};
-    n[k / 2] = k % 2 == 0 ? 1.0 : -1.0;
-    x[k / 2] = at[k];
-    std::ostringstream w;
-    w << "[[walls]]\nname = \"" << names[k] << "\"\npoint = [" << x[0] << ", " << x[1] << ", "
-      << x[2] << "]\nnormal = [" << n[0] << ", " << n[1] << ", " << n[2] << "]\n";
-    walls += w.str();
-  }
-  const fs::path input = write_input(
-      dir, "squeeze",
-      "[simulation]\nname = \"squeeze\"\ndimension = 3\n"
-      "[grid]\norigin = [0.0, 0.0, 0.0]\nextent = [0.004, 0.006, 0.004]\ncell_size = 0.0005\n"
-      "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = 990.0\nlambda = 3e6\n"
-      "mu = 1.5e6\n"
-      "[[grains]]\nshape = \"sphere\"\nmaterial = \"gel\"\ncenter = [0.002, 0.002, 0.002]\n"
-      "radius = 0.001\n"
-      "[[grains]]\nshape = \"sphere\"\nmaterial = \"gel\"\ncenter = [0.002, 0.004, 0.002]\n"
-      "radius = 0.001\n" +
-          walls +
-          "[loading]\n[[loading.stages]]\nname = \"squeeze\"\n[[loading.stages.walls]]\n"
-          "name = \"top\"\nvelocity = [0.0, -0.5, 0.0]\n"
-          "[time]\ndt = 2e-5\nend_time = 0.0008\n[output]\nvtu_interval = 2e-4\n");
+  const fs::path input =
+      write_input(dir, "squeeze", squeeze_input("squeeze", "vtu_interval = 2e-4\n"));
   const fs::path full = dir / "full", split = dir / "split";
   const auto a = run("run -q -t 2 -o " + full.string() + " " + input.string());
   ASSERT_EQ(a.code, 0) << a.output;
@@ -172,6 +181,87 @@ TEST(ThreeDApp, SqueezedSpheresRestartBitwise) {
   EXPECT_TRUE(read_file(full / last) == read_file(split / last)) << "final checkpoints differ";
 }
 
+// Issue 18: the coverage columns and `[output] grains = true` in 3D, on the squeezed spheres.
+// At t = 0 no domain overlaps another or leaves the box, `phi_geometric` is the volume of the
+// points' cubic domains over the box's (the spheres' lattice, not Φ), and the pores are the one
+// void around the spheres. At every snapshot the per-grain volumes sum to V_s, their
+// volume-weighted stresses to the row's Love-Weber stress (all six components, as the mean grain
+// stress columns do), and the contact-force rows of the bottom wall to its force in the time
+// series.
+TEST(ThreeDApp, CoverageAndGrainOutputs) {
+  const fs::path dir = scratch("grains");
+  const fs::path input = write_input(
+      dir, "grains", squeeze_input("grains", "vtu = false\nvtu_interval = 4e-4\ngrains = true\n"));
+  const auto r = run("run -q -t 2 -o " + (dir / "out").string() + " " + input.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  auto csv = read_csv(dir / "out" / "grains.csv");
+  for (const char* c : {"phi_geometric", "overlap_over_Vs", "outside_over_Vs", "pore_diameter",
+                        "stress_volume", "grain_sxx", "grain_szz", "grain_syz", "contact_syy",
+                        "contact_sxz", "fabric_rzz", "fabric_a", "fabric_contacts"})
+    EXPECT_EQ(csv[c].size(), csv["time"].size()) << c;
+  std::printf(
+      "  t = 0: Phi %.6f, phi_geometric %.6f, pore diameter %.4g m; end: Phi %.6f, "
+      "phi_geometric %.6f, overlap/Vs %.3g, outside/Vs %.3g\n",
+      csv["phi"].front(), csv["phi_geometric"].front(), csv["pore_diameter"].front(),
+      csv["phi"].back(), csv["phi_geometric"].back(), csv["overlap_over_Vs"].back(),
+      csv["outside_over_Vs"].back());
+  EXPECT_EQ(csv["overlap_over_Vs"].front(), 0.0);
+  EXPECT_EQ(csv["outside_over_Vs"].front(), 0.0);
+  // The points' domains at t = 0 are the lattice's cubes of side h/2 (280 per sphere, 4.4 % more
+  // than 4/3 pi R^3): phi_geometric is their volume over the box's, to the voxels' staircase.
+  auto grains0 = read_csv(dir / "out" / "grains_grains_000000.csv");
+  const double cubes = (grains0["points"][0] + grains0["points"][1]) * std::pow(0.25e-3, 3);
+  EXPECT_NEAR(csv["phi_geometric"].front(), cubes / csv["box_volume"].front(), 2e-3);
+  // One void around both spheres: (6 V / pi)^(1/3) of the box volume less the spheres'.
+  const double pore = csv["box_volume"].front() * (1 - csv["phi_geometric"].front());
+  EXPECT_NEAR(csv["pore_diameter"].front(), std::cbrt(6 * pore / std::numbers::pi), 1e-9);
+  EXPECT_GT(csv["phi_geometric"].back(), csv["phi_geometric"].front());
+  // The contact stress -(1/V) sym Σ F ⊗ ℓ against the grains' (the inertia term apart).
+  std::printf("  end: grain_syy %.5g Pa, contact_syy %.5g Pa, fabric_a %.3g (%g contacts)\n",
+              csv["grain_syy"].back(), csv["contact_syy"].back(), csv["fabric_a"].back(),
+              csv["fabric_contacts"].back());
+  EXPECT_NEAR(csv["contact_syy"].back() / csv["grain_syy"].back(), 1.0, 0.02);
+  EXPECT_EQ(csv["fabric_a"].back(), 2.5);  // one contact normal, along y: (5/2)(1 - 0)
+  for (std::size_t k = 0; k < csv["time"].size(); ++k)
+    for (const char* c : {"xx", "yy", "zz", "xy", "xz", "yz"}) {
+      const double lw = csv[std::string("lw_s") + c][k];
+      EXPECT_NEAR(csv[std::string("grain_s") + c][k], lw, 1e-12 * std::abs(lw) + 1e-9) << c;
+    }
+
+  const auto& time = csv["time"];
+  for (int n = 0; n < 3; ++n) {  // t = 0, 4e-4, 8e-4 s
+    auto grains = read_csv(dir / "out" / fmt::format("grains_grains_{:06d}.csv", n));
+    auto forces = read_csv(dir / "out" / fmt::format("grains_forces_{:06d}.csv", n));
+    ASSERT_EQ(grains["volume"].size(), 2u);
+    const double t = grains["time"].front();
+    const auto row = static_cast<std::size_t>(
+        std::min_element(time.begin(), time.end(),
+                         [&](double a, double b) { return std::abs(a - t) < std::abs(b - t); }) -
+        time.begin());
+    ASSERT_NEAR(time[row], t, 1e-12);
+    EXPECT_NEAR(grains["volume"][0] + grains["volume"][1], csv["Vs"][row], 1e-12 * csv["Vs"][row]);
+    for (const char* c : {"xx", "yy", "zz", "xy", "xz", "yz"}) {
+      const std::string s = std::string("s") + c;
+      const double sum = (grains["volume"][0] * grains[s][0] + grains["volume"][1] * grains[s][1]) /
+                         csv["box_volume"][row];
+      const double lw = csv[std::string("lw_") + s][row];
+      EXPECT_NEAR(sum, lw, 1e-10 * std::abs(lw) + 1e-9) << s << " snapshot " << n;
+    }
+    // The pressure is -tr(sigma)/3 of the grain's own stress.
+    EXPECT_NEAR(grains["pressure"][0],
+                -(grains["sxx"][0] + grains["syy"][0] + grains["szz"][0]) / 3,
+                1e-9 * std::abs(grains["pressure"][0]) + 1e-9);
+    double bottom = 0;  // bottom wall: wall 2, body -1 - 2
+    for (std::size_t c = 0; c < forces["a"].size(); ++c)
+      if (forces["a"][c] == -3) bottom += forces["fy"][c];
+    const double fy = csv["wall_bottom_fy"][row];
+    EXPECT_NEAR(bottom, -fy, 1e-9 * std::abs(fy) + 1e-12) << "snapshot " << n;
+    if (n == 2) {
+      EXPECT_LT(fy, 0.0);  // the grains press on the bottom wall
+    }
+  }
+}
+
 // Bad 3D inputs: exit 2, nothing run, and the message names the file, the key and what it
 // expected.
 TEST(ThreeDApp, BadInputsAreRefusedWithExitTwo) {
@@ -202,9 +292,7 @@ TEST(ThreeDApp, BadInputsAreRefusedWithExitTwo) {
       {"disk", head + with("shape = \"sphere\"", "shape = \"disk\"") + tail, "grains[0].shape",
        "shape \"disk\" is 2D only, but [simulation] dimension = 3: use shape = \"sphere\""},
       {"spin", head + kGelSphere + "[grains.initial]\nangular_velocity = 10.0\n" + tail,
-       "grains[0].initial.angular_velocity", "2D only"},
-      {"grains_output", head + kGelSphere + tail + "[output]\ngrains = true\n", "output.grains",
-       "2D only"}};
+       "grains[0].initial.angular_velocity", "2D only"}};
   for (const auto& c : cases) {
     const fs::path input = write_input(dir, c.name, c.text);
     const auto r = run("run -q -o " + (dir / ("out_" + c.name)).string() + " " + input.string());
