@@ -37,7 +37,7 @@ struct Run {
   std::optional<analysis::CompactionFit> fit;
   std::vector<std::size_t> fitted;  // rows fitted
   double identity_error = 0;        // max |ln(Vs/Vs0) - ln(Φ/Φ0) - ε| (paper eq. (9))
-  std::vector<double> pressure;  // P = -(σ̄xx + σ̄yy)/2 of the Love-Weber stress per row [Pa]
+  std::vector<double> pressure;     // P = -tr(σ̄)/Dim of the Love-Weber stress per row [Pa]
   std::optional<analysis::PressureLawFit> law;  // Φ(P) beyond jamming
 };
 
@@ -86,6 +86,22 @@ void read_input_copy(Run& run, std::string& name) {
       run.lambda, run.mu, static_cast<int>(root["simulation"]["dimension"].value_or(2)));
 }
 
+/// The mean pressure -tr(σ)/Dim [Pa] per row of the stress columns <prefix>xx, <prefix>yy and, in
+/// a 3D run's CSV, <prefix>zz.
+std::vector<double> mean_pressure(const analysis::TimeSeries& csv, const std::string& prefix) {
+  const bool three_d = csv.has(prefix + "zz");
+  std::vector<const std::vector<double>*> diagonal{&csv.column(prefix + "xx"),
+                                                   &csv.column(prefix + "yy")};
+  if (three_d) diagonal.push_back(&csv.column(prefix + "zz"));
+  std::vector<double> p(csv.rows());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    double trace = 0;
+    for (const auto* c : diagonal) trace += (*c)[i];
+    p[i] = -trace / static_cast<double>(diagonal.size()) + 0.0;  // + 0: no -0
+  }
+  return p;
+}
+
 void analyse(Run& run, const analysis::JammingCriterion& criterion) {
   const auto& phi = run.csv.column("phi");
   const auto& eps = run.csv.column("eps");
@@ -115,10 +131,7 @@ void analyse(Run& run, const analysis::JammingCriterion& criterion) {
   }
   // The pressure law Φ(P) on the same rows, P the mean pressure of the Love-Weber stress.
   if (!run.csv.has("lw_sxx") || !run.csv.has("lw_syy")) return;
-  const auto& sxx = run.csv.column("lw_sxx");
-  const auto& syy = run.csv.column("lw_syy");
-  for (std::size_t i = 0; i < phi.size(); ++i)
-    run.pressure.push_back(-0.5 * (sxx[i] + syy[i]) + 0.0);  // + 0: no -0
+  run.pressure = mean_pressure(run.csv, "lw_s");
   std::vector<double> pp;
   for (const std::size_t i : run.fitted) pp.push_back(run.pressure[i]);
   try {
@@ -178,16 +191,16 @@ void grain_analysis(const Run& run, std::size_t r, const std::vector<double>& ta
   const auto& time = run.csv.column("time");
   const auto& z = run.csv.column("Z");
   const auto& a = run.csv.column("fabric_a");
-  const auto& angle = run.csv.column("fabric_angle");
+  // A 3D run has no fabric angle (docs/observables.md): its column is left empty.
+  const bool has_angle = run.csv.has("fabric_angle");
   const auto& nc = run.csv.column("fabric_contacts");
-  const auto& gxx = run.csv.column("grain_sxx");
-  const auto& gyy = run.csv.column("grain_syy");
-  const auto& cxx = run.csv.column("contact_sxx");
-  const auto& cyy = run.csv.column("contact_syy");
+  const std::vector<double> grain_p = mean_pressure(run.csv, "grain_s");
+  const std::vector<double> contact_p = mean_pressure(run.csv, "contact_s");
   for (std::size_t i = 0; i < phi.size(); ++i)
-    fabric += fmt::format("{},{},{},{},{},{},{},{},{}\n", r, num(time[i]), num(phi[i]), num(z[i]),
-                          num(a[i]), num(angle[i]), num(nc[i]), num(-0.5 * (gxx[i] + gyy[i]) + 0.0),
-                          num(-0.5 * (cxx[i] + cyy[i]) + 0.0));
+    fabric +=
+        fmt::format("{},{},{},{},{},{},{},{},{}\n", r, num(time[i]), num(phi[i]), num(z[i]),
+                    num(a[i]), has_angle ? num(run.csv.column("fabric_angle")[i]) : std::string(),
+                    num(nc[i]), num(grain_p[i]), num(contact_p[i]));
   if (targets.empty()) return;
   const auto snaps = grain_snapshots(run);
   if (snaps.empty()) {

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <sstream>
@@ -59,7 +60,8 @@ std::map<std::string, std::vector<double>> read_csv(const fs::path& path) {
     std::stringstream ls(line);
     std::size_t k = 0;
     for (std::string f; std::getline(ls, f, ',') && k < names.size(); ++k)
-      cols[names[k]].push_back(std::stod(f));
+      cols[names[k]].push_back(f.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                         : std::stod(f));  // empty: not defined (analyze)
   }
   return cols;
 }
@@ -260,6 +262,19 @@ TEST(ThreeDApp, CoverageAndGrainOutputs) {
       EXPECT_LT(fy, 0.0);  // the grains press on the bottom wall
     }
   }
+  // `mpmcd analyze` reads the 3D grain columns: its fabric series has the 3D mean pressures
+  // -tr(sigma)/3 of the grains and of the contacts (no fabric angle in 3D).
+  const auto a = run("analyze --no-plots " + (dir / "out").string());
+  ASSERT_EQ(a.code, 0) << a.output;
+  auto fabric = read_csv(dir / "out" / "analysis" / "fabric.csv");
+  ASSERT_EQ(fabric["grain_pressure"].size(), csv["time"].size());
+  for (std::size_t k = 0; k < csv["time"].size(); ++k)
+    for (const char* s : {"grain", "contact"}) {
+      const std::string c = std::string(s) + "_s";
+      const double p = -(csv[c + "xx"][k] + csv[c + "yy"][k] + csv[c + "zz"][k]) / 3;
+      EXPECT_NEAR(fabric[std::string(s) + "_pressure"][k], p, 1e-9 * std::abs(p) + 1e-9)
+          << s << " row " << k;
+    }
 }
 
 // Bad 3D inputs: exit 2, nothing run, and the message names the file, the key and what it
