@@ -192,15 +192,15 @@ void grain_analysis(const Run& run, std::size_t r, const std::vector<double>& ta
   const auto& z = run.csv.column("Z");
   const auto& a = run.csv.column("fabric_a");
   // A 3D run has no fabric angle (docs/observables.md): its column is left empty.
-  const bool has_angle = run.csv.has("fabric_angle");
+  const std::vector<double>* angle =
+      run.csv.has("fabric_angle") ? &run.csv.column("fabric_angle") : nullptr;
   const auto& nc = run.csv.column("fabric_contacts");
   const std::vector<double> grain_p = mean_pressure(run.csv, "grain_s");
   const std::vector<double> contact_p = mean_pressure(run.csv, "contact_s");
   for (std::size_t i = 0; i < phi.size(); ++i)
-    fabric +=
-        fmt::format("{},{},{},{},{},{},{},{},{}\n", r, num(time[i]), num(phi[i]), num(z[i]),
-                    num(a[i]), has_angle ? num(run.csv.column("fabric_angle")[i]) : std::string(),
-                    num(nc[i]), num(grain_p[i]), num(contact_p[i]));
+    fabric += fmt::format("{},{},{},{},{},{},{},{},{}\n", r, num(time[i]), num(phi[i]), num(z[i]),
+                          num(a[i]), angle ? num((*angle)[i]) : std::string(), num(nc[i]),
+                          num(grain_p[i]), num(contact_p[i]));
   if (targets.empty()) return;
   const auto snaps = grain_snapshots(run);
   if (snaps.empty()) {

@@ -6,10 +6,10 @@
 #include "mpmcd/mpm/solver.hpp"
 
 #include <fmt/format.h>
-#include <cstdio>
-#include <cstdlib>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <stdexcept>
