@@ -458,10 +458,11 @@ mpm::Settings<Dim> build_settings(const io::Config& cfg, const mpm::Model<Dim>& 
   c.active_set = cfg.contact.solver == "active_set";
   // Delassus operator: the lumped 1/m_I is accurate when inertia dominates a step (theta c_p dt/h
   // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered
-  // contact-Newton loop converging in a few iterations.
+  // contact-Newton loop converging in a few iterations. Judged at the largest step of the run.
   double cp = 0;
   for (const double c_k : wave_speeds(model)) cp = std::max(cp, c_k);
-  const double courant = cfg.time.theta * cp * cfg.time.dt / cfg.grid.cell_size;
+  const double dt_max = cfg.time.control == "newton" ? cfg.time.dt_max : cfg.time.dt;
+  const double courant = cfg.time.theta * cp * dt_max / cfg.grid.cell_size;
   c.grain_compliance =
       cfg.contact.delassus == "grain" || (cfg.contact.delassus == "auto" && courant > 0.1);
   const auto nm = static_cast<int>(cfg.materials.size());

@@ -211,7 +211,7 @@ void Run<Dim>::commit(const mpm::StepStats& st, double dt) {
   t_ += dt;
   ++summary_.steps;
   summary_.newton_iterations += st.iterations;
-  if (dt_control_.succeeded())
+  if (dt_control_.succeeded(st.iterations, dt) && !dt_control_.adaptive())
     log().info("dt restored to {:.4g} s at t = {:.9g} s", dt_control_.dt(), t_);
 }
 

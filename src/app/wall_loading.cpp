@@ -63,7 +63,10 @@ WallLoading<Dim>::WallLoading(const io::Config& config, const std::vector<walls:
     mp = std::max(mp, model.laws[m]->wave_modulus());
     c_min = std::min(c_min, c[m]);
   }
+  // Δt of the gain: the first step, and the largest one where the stiffness answers (Δt that
+  // follows the Newton count grows up to dt_max).
   const double dt = config.time.dt, h = config.grid.cell_size;
+  const double dt_max = config.time.control == "newton" ? config.time.dt_max : dt;
   if (config.loading.gain > 0) {
     gain_ = config.loading.gain;
     gain_source_ = "loading.gain";
@@ -71,12 +74,13 @@ WallLoading<Dim>::WallLoading(const io::Config& config, const std::vector<walls:
     // docs/loading.md, "Gain": the servo's loop gain per step stays below one both where the
     // wall's first node row answers by its inertia (stress rho h dv / dt for a velocity change
     // dv) and where the cell next to the wall answers by its stiffness (M_p dt v / h).
-    const double limit = std::min(dt / (rho * h), h / (mp * dt));
+    const double limit = std::min(dt / (rho * h), h / (mp * dt_max));
     gain_ = config.loading.gain_fraction * limit;
     gain_source_ = fmt::format(
-        "{} min(dt/(rho h), h/(M_p dt)) with rho = {:.6g} kg/m^3, M_p = {:.6g} Pa, dt = {:.6g} s, "
-        "h = {:.6g} m",
-        config.loading.gain_fraction, rho, mp, dt, h);
+        "{} min(dt/(rho h), h/(M_p dt{})) with rho = {:.6g} kg/m^3, M_p = {:.6g} Pa, dt = {:.6g} "
+        "s{}, h = {:.6g} m",
+        config.loading.gain_fraction, dt_max > dt ? "_max" : "", rho, mp, dt,
+        dt_max > dt ? fmt::format(", dt_max = {:.6g} s", dt_max) : "", h);
   }
   if (config.loading.max_speed > 0) {
     max_speed_ = config.loading.max_speed;

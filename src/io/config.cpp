@@ -253,7 +253,23 @@ Schema build_schema() {
            .less_than(1.0)
            .default_of_member(),
        KeySpec::integer("recover_steps", &TimeSection::recover_steps, "",
-                        "successful steps after which a cut dt is doubled back")
+                        "successful steps after which a cut dt is doubled back (control = "
+                        "\"newton\": may grow again)")
+           .at_least(1)
+           .default_of_member(),
+       KeySpec::string("control", &TimeSection::control,
+                       "\"fixed\": dt, cut on failure and restored; \"newton\": after each step "
+                       "dt is scaled by sqrt(target_iterations / Newton iterations), within [0.5, "
+                       "1.25], dt_min and dt_max")
+           .one_of({"fixed", "newton"})
+           .default_of_member(),
+       KeySpec::number("dt_max", &TimeSection::dt_max, "s",
+                       "largest step, control = \"newton\" only; dt is the first step")
+           .greater_than(0.0)
+           .defaults("dt"),
+       KeySpec::integer("target_iterations", &TimeSection::target_iterations, "",
+                        "Newton iterations per step aimed at, control = \"newton\" only; below "
+                        "solver.max_iterations")
            .at_least(1)
            .default_of_member()});
 
@@ -443,7 +459,8 @@ Schema build_schema() {
        KeySpec::number("gain_fraction", &LoadingSection::gain_fraction, "",
                        "the automatic gain as a fraction of the step's stability limit "
                        "min(dt/(rho h), h/(M_p dt)) (rho, M_p: the densest and stiffest grain "
-                       "material, dt = time.dt, h = grid.cell_size)")
+                       "material, dt = time.dt, h = grid.cell_size; with time.control = "
+                       "\"newton\" the second dt is time.dt_max)")
            .greater_than(0.0)
            .at_most(1.0)
            .default_of_member(),

@@ -58,6 +58,7 @@ class ConfigReader {
     if (c.loads.gravity.empty()) c.loads.gravity.assign(dim_, 0.0);
     read_time(r, c);
     r.sub(&Config::solver).fill(c.solver);
+    check_time_against_solver(r, c);
     read_contact(r, c);
     read_walls(r, c);
     read_loading(r, c);
@@ -353,6 +354,24 @@ class ConfigReader {
     if (!(t.dt_min <= t.dt))
       r.fail(&TimeSection::dt_min, fmt::format("expected 0 < dt_min <= dt = {} s, got {}",
                                                number_text(t.dt), number_text(t.dt_min)));
+    if (t.control != "newton") {
+      for (const std::string& k :
+           {r.name(&TimeSection::dt_max), r.name(&TimeSection::target_iterations)})
+        if (r.has(k)) r.fail(k, "key is only for control = \"newton\"");
+    }
+    if (!r.has(&TimeSection::dt_max)) t.dt_max = t.dt;
+    if (!(t.dt_max >= t.dt))
+      r.fail(&TimeSection::dt_max, fmt::format("expected dt_max >= dt = {} s, got {}",
+                                               number_text(t.dt), number_text(t.dt_max)));
+  }
+
+  // Keys of [time] bounded by [solver] (read after it).
+  void check_time_against_solver(const TableReader& root, const Config& c) {
+    const TableReader r = root.sub(&Config::time);
+    if (c.time.control == "newton" && !(c.time.target_iterations < c.solver.max_iterations))
+      r.fail(&TimeSection::target_iterations,
+             fmt::format("expected target_iterations < solver.max_iterations = {}, got {}",
+                         c.solver.max_iterations, c.time.target_iterations));
   }
 
   void read_contact(const TableReader& root, Config& c) {

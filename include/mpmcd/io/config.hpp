@@ -87,7 +87,11 @@ struct TimeSection {
   double theta = 1.0;       ///< theta of the theta-method, in [0.5, 1] [-]
   double dt_min = 0.0;      ///< smallest step allowed after cuts [s] (default dt/1024)
   double cut_factor = 0.5;  ///< factor applied to dt when a step fails, in (0, 1) [-]
-  int recover_steps = 20;   ///< successful steps after which a cut dt is doubled back [-]
+  int recover_steps = 20;   ///< successful steps after which a cut dt may grow again [-]
+  /// "fixed" (dt, cut on failure) or "newton" (dt follows the Newton count, docs/robustness.md) [-]
+  std::string control = "fixed";
+  double dt_max = 0.0;        ///< largest step with control = "newton" [s] (default dt)
+  int target_iterations = 6;  ///< Newton iterations per step that control = "newton" aims at [-]
 };
 
 /// [solver]: Newton-Raphson and linear solver settings.

@@ -41,9 +41,9 @@ fs::path scratch(const std::string& name) {
 // Two gel disks thrown at each other in a box of three walls under gravity: they collide at
 // about step 12, bounce off each other and the side walls (contacts all along, so warm-start
 // impulses matter). About 3 ms per step.
-// `contact`: more lines of the [contact] table.
+// `contact`, `time`: more lines of the [contact] and [time] tables.
 fs::path write_case(const fs::path& dir, int steps, const std::string& checkpoint,
-                    const std::string& contact = "") {
+                    const std::string& contact = "", const std::string& time = "") {
   const fs::path p = dir / "pair.toml";
   std::ofstream(p) << "[simulation]\nname = \"pair\"\n"
                       "[grid]\norigin = [0.0, 0.0]\nextent = [0.02, 0.012]\ncell_size = 0.001\n"
@@ -60,7 +60,8 @@ fs::path write_case(const fs::path& dir, int steps, const std::string& checkpoin
                       "[[walls]]\nname = \"right\"\npoint = [0.0185, 0.0]\nnormal = [-1.0, 0.0]\n"
                       "[loads]\ngravity = [0.0, -9.81]\n"
                       "[time]\ndt = 2e-5\nend_time = "
-                   << steps * 2e-5 << "\n[contact]\nfriction = 0.3\n"
+                   << steps * 2e-5 << "\n"
+                   << time << "[contact]\nfriction = 0.3\n"
                    << contact
                    << "[output]\nfolder = \"out\"\nvtu_interval = 1e-4\n"
                       "[checkpoint]\n"
@@ -215,6 +216,38 @@ TEST(Restart, StopHalfWayAndResumeIsBitwise) {
 // the checkpoint check refused before 2026-11-25 ("names a node that does not exist").
 TEST(Restart, StopHalfWayAndResumeWithFaceContactsIsBitwise) {
   stop_half_way_and_resume("half_faces", "wall_contact = \"points\"\ngrain_contact = \"faces\"\n");
+}
+
+// Δt from the Newton count (docs/robustness.md): the step changes along the run (the checkpoint
+// holds Δt and the good steps since the last cut), and a run stopped half-way and resumed ends
+// on the same bits in the same number of steps.
+TEST(Restart, NewtonStepControlResumesBitwise) {
+  mpmcd::setup_logging(mpmcd::Verbosity::kQuiet);
+  const fs::path dir = scratch("newton");
+  const fs::path in = write_case(dir, 60, "keep = 5\n", "",
+                                 "control = \"newton\"\ndt_max = 8e-5\ntarget_iterations = 4\n"
+                                 "recover_steps = 2\n");
+  const auto cfg = mpmcd::io::load_config(in.string());
+  mpmcd::app::RunOptions opt;
+  opt.threads = 1;
+  opt.output_dir = (dir / "full").string();
+  const auto full = mpmcd::app::run_simulation(cfg, opt);
+  EXPECT_FALSE(full.interrupted);
+  // Not 60 steps of 2e-5 s: the step grew in flight and shrank in the collision.
+  EXPECT_LT(full.steps, 50);
+  EXPECT_GT(full.steps, 15);
+
+  opt.output_dir = (dir / "split").string();
+  opt.stop_after = full.steps / 2;
+  const auto first = mpmcd::app::run_simulation(cfg, opt);
+  ASSERT_TRUE(first.interrupted);
+  const auto restart = mpmcd::app::load_restart(first.checkpoint, "");
+  mpmcd::app::RunOptions ropt;
+  ropt.threads = 1;
+  ropt.restart = first.checkpoint;
+  const auto second = mpmcd::app::run_simulation(restart.config, ropt, &restart.state);
+  EXPECT_EQ(second.steps, full.steps);
+  expect_identical_runs(dir / "full", dir / "split", full.steps);
 }
 
 // The real binary: SIGTERM after some progress -> exit 4 and the resume line; resuming it gives
