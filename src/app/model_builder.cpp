@@ -461,8 +461,7 @@ mpm::Settings<Dim> build_settings(const io::Config& cfg, const mpm::Model<Dim>& 
   // contact-Newton loop converging in a few iterations. Judged at the largest step of the run.
   double cp = 0;
   for (const double c_k : wave_speeds(model)) cp = std::max(cp, c_k);
-  const double dt_max = cfg.time.control == "newton" ? cfg.time.dt_max : cfg.time.dt;
-  const double courant = cfg.time.theta * cp * dt_max / cfg.grid.cell_size;
+  const double courant = cfg.time.theta * cp * cfg.time.largest_dt() / cfg.grid.cell_size;
   c.grain_compliance =
       cfg.contact.delassus == "grain" || (cfg.contact.delassus == "auto" && courant > 0.1);
   const auto nm = static_cast<int>(cfg.materials.size());

@@ -18,7 +18,7 @@ StepController::StepController(double dt, double cut_factor, double dt_min,
 
 StepController::StepController(const io::TimeSection& time)
     : StepController(time.dt, time.cut_factor, time.dt_min, time.recover_steps,
-                     time.control == "newton" ? time.target_iterations : 0, time.dt_max) {}
+                     time.control == "newton" ? time.target_iterations : 0, time.largest_dt()) {}
 
 void StepController::restore(double dt, std::int64_t good_since_cut) {
   dt_ = std::min(dt, dt_max_);  // an input changed between the runs may lower the largest step

@@ -66,7 +66,7 @@ WallLoading<Dim>::WallLoading(const io::Config& config, const std::vector<walls:
   // Δt of the gain: the first step, and the largest one where the stiffness answers (Δt that
   // follows the Newton count grows up to dt_max).
   const double dt = config.time.dt, h = config.grid.cell_size;
-  const double dt_max = config.time.control == "newton" ? config.time.dt_max : dt;
+  const double dt_max = config.time.largest_dt();
   if (config.loading.gain > 0) {
     gain_ = config.loading.gain;
     gain_source_ = "loading.gain";

@@ -4,6 +4,7 @@
 /// every key is documented in docs/input.md, generated from that schema. The initial values below
 /// are the defaults of absent keys, and the schema documents them from here (the defaults that
 /// depend on other keys, e.g. time.dt_min = dt/1024, are set by the reader).
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <map>
@@ -92,6 +93,9 @@ struct TimeSection {
   std::string control = "fixed";
   double dt_max = 0.0;        ///< largest step with control = "newton" [s] (default dt)
   int target_iterations = 6;  ///< Newton iterations per step that control = "newton" aims at [-]
+
+  /// The largest step of the run: dt_max (at least dt) with control = "newton", else dt [s].
+  double largest_dt() const { return control == "newton" ? std::max(dt, dt_max) : dt; }
 };
 
 /// [solver]: Newton-Raphson and linear solver settings.
