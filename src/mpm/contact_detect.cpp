@@ -8,6 +8,7 @@
 #include <tuple>
 #include <vector>
 
+#include "mpmcd/contact/geometry.hpp"
 #include "solver_detail.hpp"
 
 namespace mpmcd::mpm {
@@ -64,11 +65,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   const auto warm = [&](std::int64_t node, std::int32_t a, std::int32_t b) {
     return warm_impulse(node, a, b);
   };
-  // Extent of point p's domain (reference half-edges r_i, the columns of `domain`, mapped by F)
-  // along the unit vector n: sum_i |n . F r_i| [m] (lp |F^T n|_1 for a lattice square).
-  const auto extent = [&](std::int64_t p, const Vec<Dim>& n) {
-    return (points_.domain[p].transpose() * (points_.F[p].transpose() * n)).cwiseAbs().sum();
-  };
+  const contact::DomainsView<Dim> pts{points_.x, points_.F, points_.domain};
   // 1. Grain fields carrying mass at each node: linked entries per global node.
   struct Entry {
     std::int32_t g, a, next;
@@ -125,9 +122,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
       const points::Grain& gr = grains_[local_[static_cast<std::size_t>(i)]];
       for (std::int64_t p = gr.begin; p < gr.end; ++p) {
         const Mat<Dim> D = points_.F[p] * points_.domain[p];
-        double r = 0;
-        for (int d = 0; d < Dim; ++d) r += D.col(d).norm();
-        point_reach_[p] = r;
+        point_reach_[p] = contact::domain_reach<Dim>(D);
         if (cs.grain_faces) point_dinv_[p] = D.inverse();
       }
     }
@@ -171,29 +166,12 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         normal /= len;
         double gap = 0;
         if (cs.criterion == GapCriterion::kGap) {
-          // Gap near the node: the smallest distance between a point domain of A and one of B
-          // in the node's support, |x_q - x_p| minus both domains' extents along x_q - x_p
-          // (a projection on the node's normal underestimates it where the normal is tilted).
-          gap = std::numeric_limits<double>::infinity();
-          for (std::int32_t k = wa.node_pts_start[A.a]; k < wa.node_pts_start[A.a + 1]; ++k) {
-            const std::int64_t p = grains_[A.g].begin + wa.node_pts[k];
-            for (std::int32_t l = wb.node_pts_start[B.a]; l < wb.node_pts_start[B.a + 1]; ++l) {
-              const std::int64_t q = grains_[B.g].begin + wb.node_pts[l];
-              const Vec<Dim> d = points_.x[q] - points_.x[p];
-              const double len_d = d.norm();
-              if (!(len_d > 0)) {
-                gap = 0;
-                continue;
-              }
-              // The bound with a margin of 1e-12 of the reaches, so that round-off in the bound
-              // never skips a pair that would lower the gap.
-              const double reach = point_reach_[p] + point_reach_[q];
-              if (len_d - reach > gap + 1e-12 * reach) continue;
-              const Vec<Dim> e = d / len_d;
-              gap = std::min(gap, len_d - extent(p, e) - extent(q, e));
-            }
-          }
-          gap = std::max(0.0, gap);
+          // Gap near the node: the smallest distance between a point domain of A and one of B in
+          // the node's support.
+          gap =
+              std::max(0.0, contact::nearest_gap<Dim>(
+                                pts, point_reach_, grains_[A.g].begin, detail::node_points(wa, A.a),
+                                grains_[B.g].begin, detail::node_points(wb, B.a)));
         }
         found[i].push_back({A, B, normal, gap, warm(n, A.g, B.g)});
       }
@@ -236,20 +214,10 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         const Vec<Dim> xn = grid_.node_position(grid_.node_coords(w.node_global[a]));
         if (wall.distance(xn, time_) > cs.wall_range * h) continue;
         items += 1.0 + (w.node_pts_start[a + 1] - w.node_pts_start[a]);
-        double gap = std::numeric_limits<double>::infinity(), ext = 0;
-        for (std::int32_t q = w.node_pts_start[a]; q < w.node_pts_start[a + 1]; ++q) {
-          const std::int64_t p = grains_[g].begin + w.node_pts[q];
-          const double e = extent(p, wall.normal);
-          ext = std::max(ext, e);
-          gap = std::min(gap, wall.distance(points_.x[p], time_) - e);
-        }
+        const double gap =
+            contact::node_wall_gap<Dim>(wall, time_, xn, pts, grains_[g].begin,
+                                        detail::node_points(w, static_cast<std::int32_t>(a)));
         if (!std::isfinite(gap)) continue;
-        // A node inside the grain may approach the wall until one whole point domain (twice the
-        // largest half-extent e of its points along n) still fits between it and the wall:
-        // gap >= d_node - 2 e. Without the 2 e the points between it and the wall are pushed
-        // through by up to e (measured: up to 0.25 h, and the Hertz load sagging); with the
-        // points' gap alone the layer down to the first node row would move with the wall.
-        gap = std::max(gap, wall.distance(xn, time_) - 2 * ext);
         wall_found[static_cast<std::size_t>(k)].push_back(
             {static_cast<std::int32_t>(a), gap,
              warm(w.node_global[a], -1 - static_cast<std::int32_t>(wi),
@@ -273,30 +241,15 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
         // per face"); the pivoting tolerates the redundancy. Gauss-Seidel stalls on redundant
         // constraints, so with it the faces of a column make one contact on their mean velocity.
         const bool per_face = cs.active_set;
-        struct Face {
-          std::int64_t column, p;
-          double dist, ext;
-        };
-        std::vector<Face> faces;
-        for (std::int64_t p = grains_[g].begin; p < grains_[g].end; ++p) {
-          const double e = extent(p, wall.normal);
-          const double dface = wall.distance(points_.x[p], time_) - e;
-          if (dface > cs.wall_range * h) continue;
-          // Column index: the cell of the point along the wall's tangent axes.
-          const Vec<Dim> xt = points_.x[p] - points_.x[p].dot(wall.normal) * wall.normal;
-          std::int64_t column = 0;
-          for (int d = 0; d < Dim; ++d)
-            column = column * 1000003 + static_cast<std::int64_t>(std::floor(xt[d] / h));
-          faces.push_back({column, p, dface, e});
-        }
+        const std::vector<contact::WallFace> faces = contact::wall_faces<Dim>(
+            wall, time_, pts, grains_[g].begin, grains_[g].end, cs.wall_range * h, h);
         items += static_cast<double>(faces.size());
-        std::sort(faces.begin(), faces.end(), [](const Face& x, const Face& y) {
-          return std::tie(x.column, x.dist, x.p) < std::tie(y.column, y.dist, y.p);
-        });
-        // One contact on the faces `pts`; `key` is its warm-start key (negative: not a node).
-        const auto add_contact = [&](const std::vector<std::int64_t>& pts, auto key_of) {
+        // One contact on the faces of `face_pts`; `key_of` gives its warm-start key (negative: not
+        // a node).
+        const auto add_contact = [&](const std::vector<std::int64_t>& face_pts, auto key_of) {
           Vec<Dim> x_face;
-          const std::int32_t sb = face_slot(static_cast<std::int32_t>(g), pts, wall.normal, x_face);
+          const std::int32_t sb =
+              face_slot(static_cast<std::int32_t>(g), face_pts, wall.normal, x_face);
           if (sb < 0) return;
           slot_key_[sb] = key_of(x_face);
           contact::Contact<Dim> c;
@@ -323,21 +276,15 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
                 grid_.cells()[d] - 1);
           return -1 - grid_.node_index(cell);
         };
-        std::vector<std::int64_t> pts;
+        std::vector<std::int64_t> surface;
         for (std::size_t f0 = 0; f0 < faces.size();) {
-          std::size_t f1 = f0;
-          pts.clear();
-          while (f1 < faces.size() && faces[f1].column == faces[f0].column) {
-            if (faces[f1].dist <= faces[f0].dist + 0.5 * faces[f0].ext) pts.push_back(faces[f1].p);
-            ++f1;
-          }
-          f0 = f1;
+          f0 = contact::column_surface(faces, f0, surface);
           if (!per_face) {
-            add_contact(pts, column_key);
+            add_contact(surface, column_key);
             continue;
           }
           // A face contact's key: -1 - its point (points keep their index within a run).
-          for (const std::int64_t p : pts)
+          for (const std::int64_t p : surface)
             add_contact(std::vector<std::int64_t>{p}, [p](const Vec<Dim>&) { return -1 - p; });
         }
         continue;

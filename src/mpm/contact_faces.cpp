@@ -8,6 +8,7 @@
 #include <tuple>
 #include <vector>
 
+#include "mpmcd/contact/geometry.hpp"
 #include "solver_detail.hpp"
 
 namespace mpmcd::mpm {
@@ -24,54 +25,9 @@ Vec<Dim> ImplicitSolver<Dim>::warm_impulse(std::int64_t key, std::int32_t a, std
 }
 
 template <int Dim>
-bool ImplicitSolver<Dim>::corner_weights(std::int32_t g, const std::vector<Vec<Dim>>& corners,
-                                         double weight, std::vector<std::int32_t>& nodes,
-                                         std::vector<double>& weights) const {
-  // The linear hat weights of each position at the grain's active nodes, `weight` each
-  // position, normalised to a sum of 1 (a node without mass gives its share to the others).
+contact::NodeBoxView<Dim> ImplicitSolver<Dim>::node_box(std::int32_t g) const {
   const GrainWork& w = *work_[g];
-  const double h = grid_.cell_size();
-  nodes.clear();
-  weights.clear();
-  double total = 0;
-  for (const Vec<Dim>& x : corners) {
-    const Vec<Dim> xi = (x - grid_.origin()) / h;
-    IVec<Dim> cell;
-    Vec<Dim> t;
-    for (int d = 0; d < Dim; ++d) {
-      cell[d] = static_cast<std::int64_t>(std::floor(xi[d]));
-      t[d] = xi[d] - static_cast<double>(cell[d]);
-    }
-    for (int b = 0; b < (1 << Dim); ++b) {
-      double wt = weight;
-      IVec<Dim> node = cell - w.box_lo;
-      for (int d = 0; d < Dim; ++d) {
-        const int up = (b >> d) & 1;
-        wt *= up ? t[d] : 1.0 - t[d];
-        node[d] += up;
-      }
-      if (wt == 0.0) continue;
-      if ((node.array() < 0).any() || (node.array() >= w.box_n.array()).any()) continue;
-      std::int64_t idx = 0, mul = 1;
-      for (int d = 0; d < Dim; ++d) {
-        idx += node[d] * mul;
-        mul *= w.box_n[d];
-      }
-      const std::int32_t a = w.box_to_active[idx];
-      if (a < 0) continue;  // no mass there: the position's weight goes to the other nodes
-      std::size_t k = 0;
-      while (k < nodes.size() && nodes[k] != a) ++k;
-      if (k == nodes.size()) {
-        nodes.push_back(a);
-        weights.push_back(0.0);
-      }
-      weights[k] += wt;
-      total += wt;
-    }
-  }
-  if (nodes.empty() || !(total > 0)) return false;
-  for (double& wk : weights) wk /= total;
-  return true;
+  return {grid_.origin(), grid_.cell_size(), w.box_lo, w.box_n, w.box_to_active};
 }
 
 template <int Dim>
@@ -106,43 +62,21 @@ std::int32_t ImplicitSolver<Dim>::weighted_slot(std::int32_t g,
 template <int Dim>
 std::int32_t ImplicitSolver<Dim>::face_slot(std::int32_t g, const std::vector<std::int64_t>& pts,
                                             const Vec<Dim>& n, Vec<Dim>& x_face) {
-  // The point's domain x_p + D s, s in [-1, 1]^Dim, D = F D0; the face toward the wall (normal
-  // n into the domain) is the face s_k = -sign(m_k . n) whose normal m_k = D^-T e_k is the most
-  // nearly parallel to n: all 2^(Dim-1) corners of that face, whatever the domain's small shear
-  // or rotation (choosing the corners that minimise s . D^T n instead switches from a face to a
-  // single corner, and so changes the constraint's nodes and weights, as soon as round-off
-  // shears the domain: docs/accuracy.md, "Uniaxial stress"). Its velocity is the mean of the
-  // corners' velocities interpolated with the linear hat (the same corner kinematics as CPDI):
-  // weights w_I = mean over the face corners of N_I(x_c).
+  // The face of each point's domain toward the wall (contact::face_toward: all 2^(Dim-1) corners
+  // of one face). Its velocity is the mean of the corners' velocities interpolated with the
+  // linear hat (the same corner kinematics as CPDI): weights w_I = mean over the face corners of
+  // N_I(x_c).
   constexpr int corners = 1 << (Dim - 1);
   std::vector<Vec<Dim>> xs;
   xs.reserve(pts.size() * corners);
   x_face.setZero();
   for (const std::int64_t p : pts) {
     const Mat<Dim> D = points_.F[p] * points_.domain[p];
-    const Mat<Dim> m = D.inverse().transpose();  // columns: face normals m_k (unnormalised)
-    int axis = 0;
-    double best = -1;
-    for (int d = 0; d < Dim; ++d) {
-      const double align = std::abs(m.col(d).dot(n)) / m.col(d).norm();
-      if (align > best) {
-        best = align;
-        axis = d;
-      }
-    }
-    Vec<Dim> s = Vec<Dim>::Zero();
-    s[axis] = m.col(axis).dot(n) > 0 ? -1.0 : 1.0;
-    x_face += (points_.x[p] + D * s) / static_cast<double>(pts.size());
-    for (int c = 0; c < corners; ++c) {
-      Vec<Dim> sc = s;
-      for (int d = 0, bit = 0; d < Dim; ++d)
-        if (s[d] == 0.0) sc[d] = (c >> bit++) & 1 ? 1.0 : -1.0;
-      xs.push_back(points_.x[p] + D * sc);
-    }
+    x_face += contact::face_toward<Dim>(points_.x[p], D, n, xs) / static_cast<double>(pts.size());
   }
   std::vector<std::int32_t> nodes;
   std::vector<double> weights;
-  if (!corner_weights(g, xs, 1.0 / corners, nodes, weights)) return -1;
+  if (!contact::corner_weights<Dim>(node_box(g), xs, 1.0 / corners, nodes, weights)) return -1;
   return weighted_slot(g, nodes, weights);
 }
 
@@ -264,25 +198,6 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
       ++off[d];
     }
   };
-  // Entry distance t of the ray x + t nu into point q's domain x_q + D s, |s_i| <= 1 (slabs);
-  // +infinity when the ray misses it or the domain lies behind x [m].
-  const auto entry = [&](std::int64_t q, const Vec<Dim>& x, const Vec<Dim>& nu) {
-    constexpr double inf = std::numeric_limits<double>::infinity();
-    const Mat<Dim>& Dq = point_dinv_[q];
-    const Vec<Dim> s0 = Dq * (x - points_.x[q]), ds = Dq * nu;
-    double t_in = -inf, t_out = inf;
-    for (int d = 0; d < Dim; ++d) {
-      if (std::abs(ds[d]) < 1e-300) {
-        if (std::abs(s0[d]) > 1.0) return inf;
-        continue;
-      }
-      double t1 = (-1.0 - s0[d]) / ds[d], t2 = (1.0 - s0[d]) / ds[d];
-      if (t1 > t2) std::swap(t1, t2);
-      t_in = std::max(t_in, t1);
-      t_out = std::min(t_out, t2);
-    }
-    return t_in <= t_out && t_out > 0 ? t_in : inf;
-  };
   // One face that makes a contact, found on the threads and turned into slots and a contact in
   // the serial order afterwards.
   struct Hit {
@@ -343,7 +258,8 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
           zone.push_back(grains_[X].begin + wx.node_pts[k]);
       std::sort(zone.begin(), zone.end());
       zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
-      std::vector<Vec<Dim>> xs(corners);
+      std::vector<Vec<Dim>> xs;
+      xs.reserve(corners);
       Hit hit;
       for (const std::int64_t p : zone) {
         const Mat<Dim> D = points_.F[p] * points_.domain[p];
@@ -370,18 +286,13 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
             double gap = std::numeric_limits<double>::infinity();
             near(Y, xf, gap_radius, [&](std::int64_t q) {
               if (gap > 0.0 && (points_.x[q] - xf).norm() <= point_reach_[q] + cut)
-                gap = std::min(gap, entry(q, xf, nu));
+                gap = std::min(gap, contact::ray_entry<Dim>(points_.x[q], point_dinv_[q], xf, nu));
             });
             if (!(gap <= cut)) continue;
-            for (int c = 0; c < corners; ++c) {
-              Vec<Dim> sc = Vec<Dim>::Zero();
-              sc[k] = sign;
-              for (int d = 0, bit = 0; d < Dim; ++d)
-                if (d != k) sc[d] = (c >> bit++) & 1 ? 1.0 : -1.0;
-              xs[static_cast<std::size_t>(c)] = points_.x[p] + D * sc;
-            }
-            if (!corner_weights(X, xs, 1.0, hit.nodes_x, hit.weights_x) ||
-                !corner_weights(Y, xs, 1.0, hit.nodes_y, hit.weights_y))
+            xs.clear();
+            contact::face_corners<Dim>(points_.x[p], D, k, sign, xs);
+            if (!contact::corner_weights<Dim>(node_box(X), xs, 1.0, hit.nodes_x, hit.weights_x) ||
+                !contact::corner_weights<Dim>(node_box(Y), xs, 1.0, hit.nodes_y, hit.weights_y))
               continue;
             hit.key = -1 - (p * 2 * Dim + 2 * k + side);
             hit.normal = nu;
@@ -412,9 +323,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
 // The members defined here (the class is instantiated in solver.cpp).
 #define MPMCD_INSTANTIATE(D)                                                                       \
   template Vec<D> ImplicitSolver<D>::warm_impulse(std::int64_t, std::int32_t, std::int32_t) const; \
-  template bool ImplicitSolver<D>::corner_weights(std::int32_t, const std::vector<Vec<D>>&,        \
-                                                  double, std::vector<std::int32_t>&,              \
-                                                  std::vector<double>&) const;                     \
+  template contact::NodeBoxView<D> ImplicitSolver<D>::node_box(std::int32_t) const;                \
   template std::int32_t ImplicitSolver<D>::weighted_slot(                                          \
       std::int32_t, const std::vector<std::int32_t>&, const std::vector<double>&);                 \
   template std::int32_t ImplicitSolver<D>::face_slot(                                              \

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mpmcd/contact/active_set.hpp"
+#include "mpmcd/contact/geometry.hpp"
 #include "mpmcd/contact/problem.hpp"
 #include "mpmcd/core/timer.hpp"
 #include "mpmcd/core/types.hpp"
@@ -157,10 +158,8 @@ class ImplicitSolver {
                          Vec<Dim>& x_face);
   // The warm-start impulse of contact (key, a, b) kept from the last step (zero if none) [N s].
   Vec<Dim> warm_impulse(std::int64_t key, std::int32_t a, std::int32_t b) const;
-  // Linear hat weights of the positions `corners` [m] at grain g's active nodes, `weight` each,
-  // normalised to a sum of 1 (nodes, weights); false if no active node carries any.
-  bool corner_weights(std::int32_t g, const std::vector<Vec<Dim>>& corners, double weight,
-                      std::vector<std::int32_t>& nodes, std::vector<double>& weights) const;
+  // Grain g's node box and active nodes on the grid (contact::corner_weights' view of its field).
+  contact::NodeBoxView<Dim> node_box(std::int32_t g) const;
   // A slot of grain g carrying the weighted mean of the velocities of its active `nodes`.
   std::int32_t weighted_slot(std::int32_t g, const std::vector<std::int32_t>& nodes,
                              const std::vector<double>& weights);
