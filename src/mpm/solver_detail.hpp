@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <span>
 #include <utility>
 #include <vector>
 
@@ -39,15 +38,6 @@ struct ImplicitSolver<Dim>::GrainWork : GrainField<Dim> {
 };
 
 namespace detail {
-/// The points of grain field w's active node a, as offsets in its grain [-] (the CSR
-/// node_pts_start / node_pts of the contact views).
-template <int Dim>
-std::span<const std::int32_t> node_points(const GrainField<Dim>& w, std::int32_t a) {
-  return std::span<const std::int32_t>(w.node_pts)
-      .subspan(static_cast<std::size_t>(w.node_pts_start[a]),
-               static_cast<std::size_t>(w.node_pts_start[a + 1] - w.node_pts_start[a]));
-}
-
 /// Records a Gauss-Seidel outcome in `stats` and returns the sums of the relative impulse change
 /// since `old` (the impulses before it), num = sum |P - P_old|^2, den = sum |P|^2 [(N s)^2].
 template <int Dim>

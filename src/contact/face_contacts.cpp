@@ -1,6 +1,6 @@
-// Contacts at the faces of the points' domains (docs/accuracy.md): the slots that carry a weighted
-// mean of a grain's nodal velocities (a face, or a set of positions), the faces facing a wall, and
-// the grain-grain contacts between a grain's boundary faces and the other grain's material.
+// Contacts at the faces of the points' domains (docs/accuracy.md, docs/contact.md): the slot of
+// the faces of a grain's points facing a wall, and the grain-grain contacts between a grain's
+// boundary faces and the other grain's material (include/mpmcd/contact/detect.hpp).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -8,80 +8,35 @@
 #include <tuple>
 #include <vector>
 
-#include "mpmcd/contact/geometry.hpp"
-#include "solver_detail.hpp"
+#include "mpmcd/contact/detect.hpp"
 
-namespace mpmcd::mpm {
-
-template <int Dim>
-Vec<Dim> ImplicitSolver<Dim>::warm_impulse(std::int64_t key, std::int32_t a, std::int32_t b) const {
-  const WarmImpulse<Dim> k{key, a, b, Vec<Dim>::Zero()};
-  auto it = std::lower_bound(previous_.begin(), previous_.end(), k,
-                             [](const WarmImpulse<Dim>& x, const WarmImpulse<Dim>& y) {
-                               return std::tie(x.node, x.a, x.b) < std::tie(y.node, y.a, y.b);
-                             });
-  if (it != previous_.end() && it->node == key && it->a == a && it->b == b) return it->impulse;
-  return Vec<Dim>::Zero();
-}
+namespace mpmcd::contact {
 
 template <int Dim>
-contact::NodeBoxView<Dim> ImplicitSolver<Dim>::node_box(std::int32_t g) const {
-  const GrainWork& w = *work_[g];
-  return {grid_.origin(), grid_.cell_size(), w.box_lo, w.box_n, w.box_to_active};
-}
-
-template <int Dim>
-std::int32_t ImplicitSolver<Dim>::weighted_slot(std::int32_t g,
-                                                const std::vector<std::int32_t>& nodes,
-                                                const std::vector<double>& weights) {
-  // Effective mass 1 / sum w_k^2 / m_k: the lumped response of the mean velocity to an impulse.
-  const GrainWork& w = *work_[g];
-  const auto sidx = static_cast<std::int32_t>(problem_.slots.size());
-  double inv_mass = 0;
-  std::int32_t primary = nodes[0];
-  double wmax = 0;
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    slot_node_.push_back(nodes[k]);
-    slot_weight_.push_back(weights[k]);
-    inv_mass += weights[k] * weights[k] / w.m[nodes[k]];
-    if (weights[k] > wmax) {
-      wmax = weights[k];
-      primary = nodes[k];
-    }
-  }
-  slot_start_.push_back(static_cast<std::int32_t>(slot_node_.size()));
-  slot_is_face_.push_back(1);
-  slot_key_.push_back(-1);
-  problem_.slots.push_back({1.0 / inv_mass, Vec<Dim>::Zero(), g, w.node_global[primary]});
-  slot_ref_.emplace_back(g, primary);
-  slot_next_.push_back(-1);  // not linked to its node: slot_of never returns a face slot
-  problem_.slots.back().v_free = slot_velocity(static_cast<std::size_t>(sidx));
-  return sidx;
-}
-
-template <int Dim>
-std::int32_t ImplicitSolver<Dim>::face_slot(std::int32_t g, const std::vector<std::int64_t>& pts,
-                                            const Vec<Dim>& n, Vec<Dim>& x_face) {
-  // The face of each point's domain toward the wall (contact::face_toward: all 2^(Dim-1) corners
-  // of one face). Its velocity is the mean of the corners' velocities interpolated with the
-  // linear hat (the same corner kinematics as CPDI): weights w_I = mean over the face corners of
-  // N_I(x_c).
+std::int32_t face_slot(const FieldView<Dim>& field, std::int32_t g, const DomainsView<Dim>& points,
+                       const std::vector<std::int64_t>& pts, const Vec<Dim>& n, Vec<Dim>& x_face,
+                       SlotMaker<Dim>& slots) {
+  // The face of each point's domain toward the wall (face_toward: all 2^(Dim-1) corners of one
+  // face). Its velocity is the mean of the corners' velocities interpolated with the linear hat
+  // (the same corner kinematics as CPDI): weights w_I = mean over the face corners of N_I(x_c).
   constexpr int corners = 1 << (Dim - 1);
   std::vector<Vec<Dim>> xs;
   xs.reserve(pts.size() * corners);
   x_face.setZero();
   for (const std::int64_t p : pts) {
-    const Mat<Dim> D = points_.F[p] * points_.domain[p];
-    x_face += contact::face_toward<Dim>(points_.x[p], D, n, xs) / static_cast<double>(pts.size());
+    const Mat<Dim> D = points.F[p] * points.domain[p];
+    x_face += face_toward<Dim>(points.x[p], D, n, xs) / static_cast<double>(pts.size());
   }
   std::vector<std::int32_t> nodes;
   std::vector<double> weights;
-  if (!contact::corner_weights<Dim>(node_box(g), xs, 1.0 / corners, nodes, weights)) return -1;
-  return weighted_slot(g, nodes, weights);
+  if (!corner_weights<Dim>(field.box, xs, 1.0 / corners, nodes, weights)) return -1;
+  return slots.weighted_slot(g, nodes, weights);
 }
 
 template <int Dim>
-double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int32_t, 4>>& links) {
+double Detector<Dim>::grain_face_contacts(const DetectInput<Dim>& in,
+                                          std::vector<std::array<std::int32_t, 4>>& links,
+                                          Problem<Dim>& problem, SlotMaker<Dim>& slots) {
   // Grain-grain contacts at the material surface (ContactSettings::grain_faces, docs/contact.md):
   // for each pair of grains A < B whose fields share nodes, every boundary face of either
   // grain's points there (no other domain of its grain just beyond it) whose outward normal
@@ -93,15 +48,18 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
   // one grain only, the other grain's corners enter it between them (mirror test: 0.72-0.80 of
   // the wall's force at d/4 instead of 0.94-0.99). The constraints are then redundant where the
   // two surfaces meet, which Gauss-Seidel tolerates at the price of more sweeps (docs/contact.md).
-  const ContactSettings<Dim>& cs = settings_.contact;
-  const double h = grid_.cell_size(), range = cs.wall_range * h;
+  const ContactSettings<Dim>& cs = *in.settings;
+  const grid::Grid<Dim>& grid = *in.grid;
+  const std::span<const FieldView<Dim>> fields = in.fields;
+  const DomainsView<Dim>& points = in.points;
+  const double h = grid.cell_size(), range = cs.wall_range * h;
   constexpr int corners = 1 << (Dim - 1);
   std::sort(links.begin(), links.end());
-  const IVec<Dim>& ncell = grid_.cells();
+  const IVec<Dim>& ncell = grid.cells();
   const auto cell_of = [&](const Vec<Dim>& x) {
     IVec<Dim> c;
     for (int d = 0; d < Dim; ++d)
-      c[d] = static_cast<std::int64_t>(std::floor((x[d] - grid_.origin()[d]) / h));
+      c[d] = static_cast<std::int64_t>(std::floor((x[d] - grid.origin()[d]) / h));
     return c;
   };
   const auto key_of = [&](const IVec<Dim>& c) -> std::int64_t {  // -1 outside the grid
@@ -122,7 +80,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
     std::vector<std::int64_t> pts;    // the points, cell by cell
     double max_reach = 0;             // the largest reach of its points [m]
   };
-  std::vector<CellTable> by_cell(grains_.size());
+  std::vector<CellTable> by_cell(fields.size());
   {
     std::vector<std::int32_t> involved;
     for (const auto& l : links) {
@@ -132,17 +90,17 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
     std::sort(involved.begin(), involved.end());
     involved.erase(std::unique(involved.begin(), involved.end()), involved.end());
     const auto ni = static_cast<std::int64_t>(involved.size());
-    const ThreadedRegion threaded(&timers_, ni > 1);
+    const ThreadedRegion threaded(in.timers, ni > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (ni > 1)
     for (std::int64_t i = 0; i < ni; ++i) {
       const std::int32_t g = involved[static_cast<std::size_t>(i)];
       CellTable& t = by_cell[static_cast<std::size_t>(g)];
-      const std::int64_t b = grains_[g].begin, e = grains_[g].end;
+      const std::int64_t b = fields[g].begin, e = fields[g].end;
       std::vector<std::int64_t> box(static_cast<std::size_t>(e - b));
       IVec<Dim> lo = IVec<Dim>::Constant(std::numeric_limits<std::int64_t>::max());
       IVec<Dim> hi = IVec<Dim>::Constant(std::numeric_limits<std::int64_t>::min());
       for (std::int64_t p = b; p < e; ++p) {
-        const IVec<Dim> c = cell_of(points_.x[p]);
+        const IVec<Dim> c = cell_of(points.x[p]);
         lo = lo.cwiseMin(c);
         hi = hi.cwiseMax(c);
         t.max_reach = std::max(t.max_reach, point_reach_[p]);
@@ -153,7 +111,7 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
       for (int d = 0; d < Dim; ++d) cells *= t.n[d];
       t.start.assign(static_cast<std::size_t>(cells) + 1, 0);
       for (std::int64_t p = b; p < e; ++p) {
-        const IVec<Dim> c = cell_of(points_.x[p]) - lo;
+        const IVec<Dim> c = cell_of(points.x[p]) - lo;
         std::int64_t k = 0, mul = 1;
         for (int d = 0; d < Dim; ++d) {
           k += c[d] * mul;
@@ -231,22 +189,22 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
   double cut = range;
   if (cs.gap_horizon > 0) {
     double speed = 0;
-    for (const auto& w : work_)
-      for (const Vec<Dim>& v : w->v) speed = std::max(speed, v.norm());
+    for (const FieldView<Dim>& w : fields)
+      for (const Vec<Dim>& v : w.v) speed = std::max(speed, v.norm());
     for (const walls::Wall<Dim>& wall : cs.walls) speed = std::max(speed, wall.velocity.norm());
-    speed += settings_.gravity.norm() * dt_;
-    cut = std::min(range, cs.gap_horizon * 2.0 * speed * dt_);
+    speed += in.gravity.norm() * in.dt;
+    cut = std::min(range, cs.gap_horizon * 2.0 * speed * in.dt);
   }
   std::vector<std::vector<Hit>> hits(passes.size());
   double items = 0;
   const auto npasses = static_cast<std::int64_t>(passes.size());
   {
-    const ThreadedRegion threaded(&timers_, npasses > 1);
+    const ThreadedRegion threaded(in.timers, npasses > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (npasses > 1) reduction(+ : items)
     for (std::int64_t pi = 0; pi < npasses; ++pi) {
       const Pass& ps = passes[static_cast<std::size_t>(pi)];
       const std::int32_t X = ps.X, Y = ps.Y;
-      const GrainWork& wx = *work_[X];
+      const FieldView<Dim>& wx = fields[X];
       // Cells searched around a face centre for Y's domains: those within max reach + cut of it
       // (at most the 2 cells searched before; usually 1 of them, a third of the points).
       const int gap_radius = static_cast<int>(
@@ -255,14 +213,14 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
       for (std::size_t i = ps.i0; i < ps.i1; ++i)
         for (std::int32_t k = wx.node_pts_start[links[i][ps.col]];
              k < wx.node_pts_start[links[i][ps.col] + 1]; ++k)
-          zone.push_back(grains_[X].begin + wx.node_pts[k]);
+          zone.push_back(wx.begin + wx.node_pts[k]);
       std::sort(zone.begin(), zone.end());
       zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
       std::vector<Vec<Dim>> xs;
       xs.reserve(corners);
       Hit hit;
       for (const std::int64_t p : zone) {
-        const Mat<Dim> D = points_.F[p] * points_.domain[p];
+        const Mat<Dim> D = points.F[p] * points.domain[p];
         const Mat<Dim>& Dinv = point_dinv_[p];
         for (int k = 0; k < Dim; ++k)
           for (const int side : {0, 1}) {
@@ -271,28 +229,28 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
             const Vec<Dim> m = Dinv.row(k).transpose();
             const double len = m.norm();
             const Vec<Dim> nu = sign * m / len;
-            const Vec<Dim> xf = points_.x[p] + sign * D.col(k);
+            const Vec<Dim> xf = points.x[p] + sign * D.col(k);
             items += 1;
             // Interior face: another domain of X holds the point half a domain beyond it.
             const Vec<Dim> xt = xf + 0.5 / len * nu;
             bool interior = false;
             near(X, xt, 1, [&](std::int64_t q) {
-              if (interior || q == p || (points_.x[q] - xt).norm() > point_reach_[q]) return;
-              interior = (point_dinv_[q] * (xt - points_.x[q])).cwiseAbs().maxCoeff() <= 1.0;
+              if (interior || q == p || (points.x[q] - xt).norm() > point_reach_[q]) return;
+              interior = (point_dinv_[q] * (xt - points.x[q])).cwiseAbs().maxCoeff() <= 1.0;
             });
             if (interior) continue;
             // Only domains within `cut` of the face centre can give a gap <= cut (their reach
             // bounds them), and once the face is inside one (gap <= 0) the gap is 0.
             double gap = std::numeric_limits<double>::infinity();
             near(Y, xf, gap_radius, [&](std::int64_t q) {
-              if (gap > 0.0 && (points_.x[q] - xf).norm() <= point_reach_[q] + cut)
-                gap = std::min(gap, contact::ray_entry<Dim>(points_.x[q], point_dinv_[q], xf, nu));
+              if (gap > 0.0 && (points.x[q] - xf).norm() <= point_reach_[q] + cut)
+                gap = std::min(gap, ray_entry<Dim>(points.x[q], point_dinv_[q], xf, nu));
             });
             if (!(gap <= cut)) continue;
             xs.clear();
-            contact::face_corners<Dim>(points_.x[p], D, k, sign, xs);
-            if (!contact::corner_weights<Dim>(node_box(X), xs, 1.0, hit.nodes_x, hit.weights_x) ||
-                !contact::corner_weights<Dim>(node_box(Y), xs, 1.0, hit.nodes_y, hit.weights_y))
+            face_corners<Dim>(points.x[p], D, k, sign, xs);
+            if (!corner_weights<Dim>(fields[X].box, xs, 1.0, hit.nodes_x, hit.weights_x) ||
+                !corner_weights<Dim>(fields[Y].box, xs, 1.0, hit.nodes_y, hit.weights_y))
               continue;
             hit.key = -1 - (p * 2 * Dim + 2 * k + side);
             hit.normal = nu;
@@ -306,31 +264,29 @@ double ImplicitSolver<Dim>::grain_face_contacts(std::vector<std::array<std::int3
   for (std::size_t pi = 0; pi < passes.size(); ++pi) {
     const std::int32_t X = passes[pi].X, Y = passes[pi].Y;
     for (const Hit& hit : hits[pi]) {
-      contact::Contact<Dim> c;
-      c.a = weighted_slot(X, hit.nodes_x, hit.weights_x);
-      c.b = weighted_slot(Y, hit.nodes_y, hit.weights_y);
-      slot_key_[c.b] = hit.key;
+      Contact<Dim> c;
+      c.a = slots.weighted_slot(X, hit.nodes_x, hit.weights_x);
+      c.b = slots.weighted_slot(Y, hit.nodes_y, hit.weights_y);
+      slots.set_key(c.b, hit.key);
       c.normal = hit.normal;
       c.gap = hit.gap;
-      c.friction = cs.friction[grains_[X].material * cs.materials + grains_[Y].material];
-      c.impulse = warm_impulse(hit.key, X, Y);
-      problem_.contacts.push_back(c);
+      c.friction = cs.friction[fields[X].material * cs.materials + fields[Y].material];
+      c.impulse = warm_impulse<Dim>(in.previous, hit.key, X, Y);
+      problem.contacts.push_back(c);
     }
   }
   return items;
 }
 
-// The members defined here (the class is instantiated in solver.cpp).
-#define MPMCD_INSTANTIATE(D)                                                                       \
-  template Vec<D> ImplicitSolver<D>::warm_impulse(std::int64_t, std::int32_t, std::int32_t) const; \
-  template contact::NodeBoxView<D> ImplicitSolver<D>::node_box(std::int32_t) const;                \
-  template std::int32_t ImplicitSolver<D>::weighted_slot(                                          \
-      std::int32_t, const std::vector<std::int32_t>&, const std::vector<double>&);                 \
-  template std::int32_t ImplicitSolver<D>::face_slot(                                              \
-      std::int32_t, const std::vector<std::int64_t>&, const Vec<D>&, Vec<D>&);                     \
-  template double ImplicitSolver<D>::grain_face_contacts(std::vector<std::array<std::int32_t, 4>>&);
+#define MPMCD_INSTANTIATE(D)                                                                   \
+  template std::int32_t face_slot<D>(const FieldView<D>&, std::int32_t, const DomainsView<D>&, \
+                                     const std::vector<std::int64_t>&, const Vec<D>&, Vec<D>&, \
+                                     SlotMaker<D>&);                                           \
+  template double Detector<D>::grain_face_contacts(const DetectInput<D>&,                      \
+                                                   std::vector<std::array<std::int32_t, 4>>&,  \
+                                                   Problem<D>&, SlotMaker<D>&);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)
 #undef MPMCD_INSTANTIATE
 
-}  // namespace mpmcd::mpm
+}  // namespace mpmcd::contact
