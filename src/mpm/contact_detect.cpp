@@ -1,11 +1,7 @@
 // Contact detection at x^n (method.md §4, docs/contact.md): the slots (grain-field nodes, and the
-// faces of the points facing a wall) and the grain-grain and grain-wall contacts with their
-// normals, gaps and warm-start impulses, then the compliance groups.
+// weighted means of a grain's nodal velocities: faces), the grain-grain and grain-wall contacts
+// found by contact::Detector on views of the grain fields, then the compliance groups.
 #include <algorithm>
-#include <array>
-#include <cmath>
-#include <limits>
-#include <tuple>
 #include <vector>
 
 #include "solver_detail.hpp"
@@ -36,6 +32,51 @@ std::int32_t ImplicitSolver<Dim>::slot_of(std::int32_t g, std::int32_t a) {
 }
 
 template <int Dim>
+std::int32_t ImplicitSolver<Dim>::weighted_slot(std::int32_t g,
+                                                const std::vector<std::int32_t>& nodes,
+                                                const std::vector<double>& weights) {
+  // Effective mass 1 / sum w_k^2 / m_k: the lumped response of the mean velocity to an impulse.
+  const GrainWork& w = *work_[g];
+  const auto sidx = static_cast<std::int32_t>(problem_.slots.size());
+  double inv_mass = 0;
+  std::int32_t primary = nodes[0];
+  double wmax = 0;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    slot_node_.push_back(nodes[k]);
+    slot_weight_.push_back(weights[k]);
+    inv_mass += weights[k] * weights[k] / w.m[nodes[k]];
+    if (weights[k] > wmax) {
+      wmax = weights[k];
+      primary = nodes[k];
+    }
+  }
+  slot_start_.push_back(static_cast<std::int32_t>(slot_node_.size()));
+  slot_is_face_.push_back(1);
+  slot_key_.push_back(-1);
+  problem_.slots.push_back({1.0 / inv_mass, Vec<Dim>::Zero(), g, w.node_global[primary]});
+  slot_ref_.emplace_back(g, primary);
+  slot_next_.push_back(-1);  // not linked to its node: slot_of never returns a face slot
+  problem_.slots.back().v_free = slot_velocity(static_cast<std::size_t>(sidx));
+  return sidx;
+}
+
+// The solver's slots as contact detection makes them (contact::SlotMaker).
+template <int Dim>
+class ImplicitSolver<Dim>::Slots final : public contact::SlotMaker<Dim> {
+ public:
+  explicit Slots(ImplicitSolver& solver) : s_(solver) {}
+  std::int32_t node_slot(std::int32_t g, std::int32_t a) override { return s_.slot_of(g, a); }
+  std::int32_t weighted_slot(std::int32_t g, const std::vector<std::int32_t>& nodes,
+                             const std::vector<double>& weights) override {
+    return s_.weighted_slot(g, nodes, weights);
+  }
+  void set_key(std::int32_t s, std::int64_t key) override { s_.slot_key_[s] = key; }
+
+ private:
+  ImplicitSolver& s_;
+};
+
+template <int Dim>
 void ImplicitSolver<Dim>::detect_contacts(double dt) {
   const ContactSettings<Dim>& cs = settings_.contact;
   const double h = grid_.cell_size();
@@ -54,310 +95,42 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   slot_is_face_.clear();
   slot_key_.clear();
   const auto nn = static_cast<std::size_t>(grid_.node_count());
-  if (node_stamp_.size() != nn) {
-    node_stamp_.assign(nn, 0);
+  if (slot_stamp_.size() != nn) {
     slot_stamp_.assign(nn, 0);
-    node_head_.assign(nn, -1);
     slot_head_.assign(nn, -1);
   }
   ++stamp_;
-  const auto warm = [&](std::int64_t node, std::int32_t a, std::int32_t b) {
-    return warm_impulse(node, a, b);
-  };
-  // Extent of point p's domain (reference half-edges r_i, the columns of `domain`, mapped by F)
-  // along the unit vector n: sum_i |n . F r_i| [m] (lp |F^T n|_1 for a lattice square).
-  const auto extent = [&](std::int64_t p, const Vec<Dim>& n) {
-    return (points_.domain[p].transpose() * (points_.F[p].transpose() * n)).cwiseAbs().sum();
-  };
-  // 1. Grain fields carrying mass at each node: linked entries per global node.
-  struct Entry {
-    std::int32_t g, a, next;
-  };
-  std::vector<Entry> entries;
-  std::vector<std::int64_t> shared;
-  for (std::size_t g : local_) {
+  // The grain fields' contact views at x^n (every grain's: the gap horizon reads all speeds).
+  field_views_.resize(work_.size());
+  for (std::size_t g = 0; g < work_.size(); ++g) {
     const GrainWork& w = *work_[g];
-    for (std::size_t a = 0; a < w.m.size(); ++a) {
-      if (w.m[a] < w.contact_mass) continue;
-      const std::int64_t n = w.node_global[a];
-      if (node_stamp_[n] != stamp_) {
-        node_stamp_[n] = stamp_;
-        node_head_[n] = -1;
-      }
-      const std::int32_t head = node_head_[n];
-      if (head >= 0 && entries[head].next < 0) shared.push_back(n);  // second field here
-      entries.push_back({static_cast<std::int32_t>(g), static_cast<std::int32_t>(a), head});
-      node_head_[n] = static_cast<std::int32_t>(entries.size()) - 1;
-    }
+    field_views_[g] = {grains_[g].begin,
+                       grains_[g].end,
+                       grains_[g].material,
+                       w.contact_mass,
+                       w.m,
+                       w.node_global,
+                       w.grad_m,
+                       w.v,
+                       w.node_pts_start,
+                       w.node_pts,
+                       {grid_.origin(), h, w.box_lo, w.box_n, w.box_to_active}};
   }
-  // The rank solving the contacts at node n (docs/parallel.md): the owner of the lowest grain with
-  // a field there (partition) or rank 0 (master); every rank sees all the fields at its nodes.
+  contact::DetectInput<Dim> in;
+  in.settings = &cs;
+  in.grid = &grid_;
+  in.points = {points_.x, points_.F, points_.domain};
+  in.fields = field_views_;
+  in.local = local_;
+  in.previous = previous_;
   const bool dist = distributed();
-  const int me = dist ? comm_->rank() : 0;
-  const auto node_rank = [&](std::int64_t n) {
-    if (!dist) return 0;
-    if (scheme_ == parallel::Scheme::kMaster) return 0;
-    std::int32_t gmin = std::numeric_limits<std::int32_t>::max();
-    for (std::int32_t e = node_head_[n]; e >= 0; e = entries[e].next)
-      gmin = std::min(gmin, entries[e].g);
-    return owner_[gmin];
-  };
-  // 2. Grain-grain contacts: every pair of fields at a shared node (three grains: three pairs).
-  // Normals and gaps per node in parallel (threads), then the contacts in the serial order.
-  struct Candidate {
-    Entry A, B;
-    Vec<Dim> normal;
-    double gap;
-    Vec<Dim> warm;  // the previous step's impulse of this contact (warm start)
-  };
-  std::vector<std::vector<Candidate>> found(shared.size());
-  const auto nshared = static_cast<std::int64_t>(shared.size());
-  // Reach of each point's domain, sum_i |F r_i| >= extent(p, e) for any unit e [m]: a pair
-  // whose distance minus both reaches is not below the gap found so far cannot lower it and is
-  // skipped (the same gap, far fewer extents: the point pairs of a CPDI node are most of the
-  // detection's time otherwise).
-  if (cs.criterion == GapCriterion::kGap || cs.grain_faces) {
-    point_reach_.resize(points_.x.size());
-    if (cs.grain_faces) point_dinv_.resize(points_.x.size());
-    const auto nl = static_cast<std::int64_t>(local_.size());
-#pragma omp parallel for schedule(dynamic, 4) if (nl > 1)
-    for (std::int64_t i = 0; i < nl; ++i) {
-      const points::Grain& gr = grains_[local_[static_cast<std::size_t>(i)]];
-      for (std::int64_t p = gr.begin; p < gr.end; ++p) {
-        const Mat<Dim> D = points_.F[p] * points_.domain[p];
-        double r = 0;
-        for (int d = 0; d < Dim; ++d) r += D.col(d).norm();
-        point_reach_[p] = r;
-        if (cs.grain_faces) point_dinv_[p] = D.inverse();
-      }
-    }
-  }
-  // Work count (Comm::count_work): node fields, pairs and point pairs of the gaps examined here.
-  double items = static_cast<double>(entries.size());
-  if (cs.grain_faces) {
-    // Contacts at the material surface (grain_face_contacts): the pairs of fields at each shared
-    // node tell which grains may touch and where.
-    std::vector<std::array<std::int32_t, 4>> links;
-    for (const std::int64_t n : shared)
-      for (std::int32_t e1 = node_head_[n]; e1 >= 0; e1 = entries[e1].next)
-        for (std::int32_t e2 = entries[e1].next; e2 >= 0; e2 = entries[e2].next) {
-          Entry A = entries[e1], B = entries[e2];
-          if (A.g > B.g) std::swap(A, B);
-          links.push_back({A.g, B.g, A.a, B.a});
-        }
-    ScopedStage faces(&timers_, "contact.detect.faces");
-    items += static_cast<double>(links.size()) + grain_face_contacts(links);
-  }
-  ThreadedRegion threaded(&timers_, nshared > 256);
-#pragma omp parallel for schedule(dynamic, 32) if (nshared > 256) reduction(+ : items)
-  for (std::int64_t i = 0; i < nshared; ++i) {
-    if (cs.grain_faces) continue;
-    const std::int64_t n = shared[i];
-    if (node_rank(n) != me) continue;
-    for (std::int32_t e1 = node_head_[n]; e1 >= 0; e1 = entries[e1].next)
-      for (std::int32_t e2 = entries[e1].next; e2 >= 0; e2 = entries[e2].next) {
-        Entry A = entries[e1], B = entries[e2];
-        if (A.g > B.g) std::swap(A, B);
-        const GrainWork& wa = *work_[A.g];
-        const GrainWork& wb = *work_[B.g];
-        items += 1.0 + (wa.node_pts_start[A.a + 1] - wa.node_pts_start[A.a]) *
-                           (wb.node_pts_start[B.a + 1] - wb.node_pts_start[B.a]);
-        // Normal from A to B (method.md §4). g^X = sum_p m_p grad N_I(x_p) points OUT of grain X
-        // (grad N_I at a point points toward the node), i.e. it is minus the gradient of X's mass
-        // density, so n ∝ grad rho^B - grad rho^A = g^A - g^B.
-        Vec<Dim> normal = wa.grad_m[A.a] - wb.grad_m[B.a];
-        const double len = normal.norm();
-        if (!(len > 1e-12 * (wa.grad_m[A.a].norm() + wb.grad_m[B.a].norm()))) continue;
-        normal /= len;
-        double gap = 0;
-        if (cs.criterion == GapCriterion::kGap) {
-          // Gap near the node: the smallest distance between a point domain of A and one of B
-          // in the node's support, |x_q - x_p| minus both domains' extents along x_q - x_p
-          // (a projection on the node's normal underestimates it where the normal is tilted).
-          gap = std::numeric_limits<double>::infinity();
-          for (std::int32_t k = wa.node_pts_start[A.a]; k < wa.node_pts_start[A.a + 1]; ++k) {
-            const std::int64_t p = grains_[A.g].begin + wa.node_pts[k];
-            for (std::int32_t l = wb.node_pts_start[B.a]; l < wb.node_pts_start[B.a + 1]; ++l) {
-              const std::int64_t q = grains_[B.g].begin + wb.node_pts[l];
-              const Vec<Dim> d = points_.x[q] - points_.x[p];
-              const double len_d = d.norm();
-              if (!(len_d > 0)) {
-                gap = 0;
-                continue;
-              }
-              // The bound with a margin of 1e-12 of the reaches, so that round-off in the bound
-              // never skips a pair that would lower the gap.
-              const double reach = point_reach_[p] + point_reach_[q];
-              if (len_d - reach > gap + 1e-12 * reach) continue;
-              const Vec<Dim> e = d / len_d;
-              gap = std::min(gap, len_d - extent(p, e) - extent(q, e));
-            }
-          }
-          gap = std::max(0.0, gap);
-        }
-        found[i].push_back({A, B, normal, gap, warm(n, A.g, B.g)});
-      }
-  }
-  threaded.done();
-  for (std::size_t i = 0; i < shared.size(); ++i)
-    for (const Candidate& f : found[i]) {
-      contact::Contact<Dim> c;
-      c.a = slot_of(f.A.g, f.A.a);
-      c.b = slot_of(f.B.g, f.B.a);
-      c.normal = f.normal;
-      c.gap = f.gap;
-      c.friction = cs.friction[grains_[f.A.g].material * cs.materials + grains_[f.B.g].material];
-      c.impulse = f.warm;
-      problem_.contacts.push_back(c);
-    }
-  // 3. Grain-wall contacts: grain nodes within wall_range cells of a wall; gap from the points.
-  ScopedStage walls_stage(&timers_, "contact.detect.walls");
-  // Node walls: each grain's candidates, gaps and warm starts on the threads, then the contacts in
-  // the serial order (wall, grain, node).
-  struct WallCandidate {
-    std::int32_t a;
-    double gap;
-    Vec<Dim> warm;
-  };
-  const std::size_t nw = cs.walls.size(), nlocal = local_.size();
-  std::vector<std::vector<WallCandidate>> wall_found(cs.wall_points ? 0 : nw * nlocal);
-  if (!cs.wall_points && nw > 0) {
-    const auto npairs = static_cast<std::int64_t>(nw * nlocal);
-    const ThreadedRegion threaded_walls(&timers_, npairs > 1);
-#pragma omp parallel for schedule(dynamic, 4) if (npairs > 1) reduction(+ : items)
-    for (std::int64_t k = 0; k < npairs; ++k) {
-      const std::size_t wi = static_cast<std::size_t>(k) / nlocal;
-      const std::size_t g = local_[static_cast<std::size_t>(k) % nlocal];
-      const walls::Wall<Dim>& wall = cs.walls[wi];
-      const GrainWork& w = *work_[g];
-      for (std::size_t a = 0; a < w.m.size(); ++a) {
-        if (w.m[a] < w.contact_mass) continue;
-        if (dist && node_rank(w.node_global[a]) != me) continue;
-        const Vec<Dim> xn = grid_.node_position(grid_.node_coords(w.node_global[a]));
-        if (wall.distance(xn, time_) > cs.wall_range * h) continue;
-        items += 1.0 + (w.node_pts_start[a + 1] - w.node_pts_start[a]);
-        double gap = std::numeric_limits<double>::infinity(), ext = 0;
-        for (std::int32_t q = w.node_pts_start[a]; q < w.node_pts_start[a + 1]; ++q) {
-          const std::int64_t p = grains_[g].begin + w.node_pts[q];
-          const double e = extent(p, wall.normal);
-          ext = std::max(ext, e);
-          gap = std::min(gap, wall.distance(points_.x[p], time_) - e);
-        }
-        if (!std::isfinite(gap)) continue;
-        // A node inside the grain may approach the wall until one whole point domain (twice the
-        // largest half-extent e of its points along n) still fits between it and the wall:
-        // gap >= d_node - 2 e. Without the 2 e the points between it and the wall are pushed
-        // through by up to e (measured: up to 0.25 h, and the Hertz load sagging); with the
-        // points' gap alone the layer down to the first node row would move with the wall.
-        gap = std::max(gap, wall.distance(xn, time_) - 2 * ext);
-        wall_found[static_cast<std::size_t>(k)].push_back(
-            {static_cast<std::int32_t>(a), gap,
-             warm(w.node_global[a], -1 - static_cast<std::int32_t>(wi),
-                  static_cast<std::int32_t>(g))});
-      }
-    }
-  }
-  for (std::size_t wi = 0; wi < cs.walls.size(); ++wi) {
-    const walls::Wall<Dim>& wall = cs.walls[wi];
-    for (std::size_t li = 0; li < nlocal; ++li) {
-      const std::size_t g = local_[li];
-      if (cs.wall_points) {
-        // Face contacts (ContactSettings::wall_points, docs/accuracy.md): per cell column
-        // along the wall, the faces of the grain's points nearest the wall in that column (within
-        // half a point's extent of the nearest) are the grain's surface there; gap = a face's
-        // distance from the wall (Signorini on the face velocity, u_n + g/dt >= 0, method.md §4).
-        // With the active-set solver each such face is one contact: as many constraints as the
-        // surface has faces, more than the node lines they move, so no combination of the
-        // surface nodes escapes them (one contact per column left an alternating mode along the
-        // wall free, which compression beyond ~20 mu released: docs/accuracy.md, "One contact
-        // per face"); the pivoting tolerates the redundancy. Gauss-Seidel stalls on redundant
-        // constraints, so with it the faces of a column make one contact on their mean velocity.
-        const bool per_face = cs.active_set;
-        struct Face {
-          std::int64_t column, p;
-          double dist, ext;
-        };
-        std::vector<Face> faces;
-        for (std::int64_t p = grains_[g].begin; p < grains_[g].end; ++p) {
-          const double e = extent(p, wall.normal);
-          const double dface = wall.distance(points_.x[p], time_) - e;
-          if (dface > cs.wall_range * h) continue;
-          // Column index: the cell of the point along the wall's tangent axes.
-          const Vec<Dim> xt = points_.x[p] - points_.x[p].dot(wall.normal) * wall.normal;
-          std::int64_t column = 0;
-          for (int d = 0; d < Dim; ++d)
-            column = column * 1000003 + static_cast<std::int64_t>(std::floor(xt[d] / h));
-          faces.push_back({column, p, dface, e});
-        }
-        items += static_cast<double>(faces.size());
-        std::sort(faces.begin(), faces.end(), [](const Face& x, const Face& y) {
-          return std::tie(x.column, x.dist, x.p) < std::tie(y.column, y.dist, y.p);
-        });
-        // One contact on the faces `pts`; `key` is its warm-start key (negative: not a node).
-        const auto add_contact = [&](const std::vector<std::int64_t>& pts, auto key_of) {
-          Vec<Dim> x_face;
-          const std::int32_t sb = face_slot(static_cast<std::int32_t>(g), pts, wall.normal, x_face);
-          if (sb < 0) return;
-          slot_key_[sb] = key_of(x_face);
-          contact::Contact<Dim> c;
-          c.a = -1;
-          c.wall = static_cast<std::int32_t>(wi);
-          c.b = sb;
-          c.normal = wall.normal;
-          c.wall_velocity = wall.velocity;
-          c.gap = std::max(0.0, wall.distance(x_face, time_));
-          c.friction = wall.friction;
-          c.impulse =
-              warm(slot_key_[sb], -1 - static_cast<std::int32_t>(wi), static_cast<std::int32_t>(g));
-          problem_.contacts.push_back(c);
-        };
-        // Warm-start key of a column's contact: -1 - the grid cell of the mean face centre
-        // projected on the wall's plane through the origin (the column: stable while the faces
-        // move toward the wall and cross grid lines, when a lost warm start would hurt most).
-        const auto column_key = [&](const Vec<Dim>& x_face) -> std::int64_t {
-          const Vec<Dim> xt = x_face - x_face.dot(wall.normal) * wall.normal;
-          IVec<Dim> cell;
-          for (int d = 0; d < Dim; ++d)
-            cell[d] = std::clamp<std::int64_t>(
-                static_cast<std::int64_t>(std::floor((xt[d] - grid_.origin()[d]) / h)), 0,
-                grid_.cells()[d] - 1);
-          return -1 - grid_.node_index(cell);
-        };
-        std::vector<std::int64_t> pts;
-        for (std::size_t f0 = 0; f0 < faces.size();) {
-          std::size_t f1 = f0;
-          pts.clear();
-          while (f1 < faces.size() && faces[f1].column == faces[f0].column) {
-            if (faces[f1].dist <= faces[f0].dist + 0.5 * faces[f0].ext) pts.push_back(faces[f1].p);
-            ++f1;
-          }
-          f0 = f1;
-          if (!per_face) {
-            add_contact(pts, column_key);
-            continue;
-          }
-          // A face contact's key: -1 - its point (points keep their index within a run).
-          for (const std::int64_t p : pts)
-            add_contact(std::vector<std::int64_t>{p}, [p](const Vec<Dim>&) { return -1 - p; });
-        }
-        continue;
-      }
-      for (const WallCandidate& f : wall_found[wi * nlocal + li]) {
-        contact::Contact<Dim> c;
-        c.a = -1;
-        c.wall = static_cast<std::int32_t>(wi);
-        c.b = slot_of(static_cast<std::int32_t>(g), f.a);
-        c.normal = wall.normal;
-        c.wall_velocity = wall.velocity;
-        c.gap = std::max(0.0, f.gap);
-        c.friction = wall.friction;
-        c.impulse = f.warm;
-        problem_.contacts.push_back(c);
-      }
-    }
-  }
-  walls_stage.done();
-  detect_items_ = items;
+  in.ranks = {dist, scheme_ == parallel::Scheme::kMaster, dist ? comm_->rank() : 0, owner_};
+  in.time = time_;
+  in.dt = dt_;
+  in.gravity = settings_.gravity;
+  in.timers = &timers_;
+  Slots slots(*this);
+  detect_items_ = detector_.detect(in, problem_, slots);
   ScopedStage groups_stage(&timers_, "contact.detect.groups");
   // Warm start: the grains see the previous step's impulses from the first iteration on; a
   // frictionless contact's along its normal of this step (max(0, P . n) n: the impulse it can
@@ -412,8 +185,10 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
 }
 
 // The members defined here (the class is instantiated in solver.cpp).
-#define MPMCD_INSTANTIATE(D)                                                    \
-  template std::int32_t ImplicitSolver<D>::slot_of(std::int32_t, std::int32_t); \
+#define MPMCD_INSTANTIATE(D)                                                       \
+  template std::int32_t ImplicitSolver<D>::slot_of(std::int32_t, std::int32_t);    \
+  template std::int32_t ImplicitSolver<D>::weighted_slot(                          \
+      std::int32_t, const std::vector<std::int32_t>&, const std::vector<double>&); \
   template void ImplicitSolver<D>::detect_contacts(double);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)

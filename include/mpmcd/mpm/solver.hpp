@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mpmcd/contact/active_set.hpp"
+#include "mpmcd/contact/detect.hpp"
 #include "mpmcd/contact/problem.hpp"
 #include "mpmcd/core/timer.hpp"
 #include "mpmcd/core/types.hpp"
@@ -61,16 +62,8 @@ struct StepStats {
       wall_force;  ///< force of the grains on each wall [N] (2D: N/m)
 };
 
-/// A contact impulse of the last converged step, used to warm start the next one.
-template <int Dim>
-struct WarmImpulse {
-  /// global grid node, -1 - grid cell of a face wall contact, or -1 - face number
-  /// (point * 2 Dim + 2 axis + side) of a grain face contact [-]
-  std::int64_t node = 0;
-  std::int32_t a = 0;                   ///< body a: grain >= 0 or wall -1 - index [-]
-  std::int32_t b = 0;                   ///< grain b [-]
-  Vec<Dim> impulse = Vec<Dim>::Zero();  ///< impulse on b over the step [N s] (2D: N s/m)
-};
+/// A contact impulse of the last converged step (the contact module's, contact/detect.hpp).
+using contact::WarmImpulse;
 
 /// Implicit MPM stepper: grains with their own nodal fields (GrainField, whose stages it calls
 /// grain by grain), coupled by Contact Dynamics. Holds non-owning references to the points,
@@ -139,6 +132,7 @@ class ImplicitSolver {
 
  private:
   struct GrainWork;
+  class Slots;  // contact::SlotMaker on this solver's grain fields (contact_detect.cpp)
   // Grain g's Newton matrix, assembled (if stale) and factorised: prepare_factor with the solver's
   // points, law and the grain's contact compliance. False on a failed factorisation.
   bool grain_factor(std::size_t g, double dt);
@@ -147,27 +141,14 @@ class ImplicitSolver {
   bool grain_compliance(std::size_t g);
   // Fills slot_basis_ and slot_rank_ from this step's contacts.
   void build_slot_bases();
+  // contact.detect: the step's slots and contacts (contact::Detector on views of the grain
+  // fields), their warm start and the compliance groups.
   void detect_contacts(double dt);
   double update_contacts(StepStats& stats);
   std::int32_t slot_of(std::int32_t g, std::int32_t a);
-  // A slot for the faces of points `pts` of grain g facing a wall of unit normal n (into the
-  // domain): the mean velocity of the face centres interpolated from g's active nodes. Writes the
-  // mean face centre to x_face [m]; -1 if the faces touch no active node.
-  std::int32_t face_slot(std::int32_t g, const std::vector<std::int64_t>& pts, const Vec<Dim>& n,
-                         Vec<Dim>& x_face);
-  // The warm-start impulse of contact (key, a, b) kept from the last step (zero if none) [N s].
-  Vec<Dim> warm_impulse(std::int64_t key, std::int32_t a, std::int32_t b) const;
-  // Linear hat weights of the positions `corners` [m] at grain g's active nodes, `weight` each,
-  // normalised to a sum of 1 (nodes, weights); false if no active node carries any.
-  bool corner_weights(std::int32_t g, const std::vector<Vec<Dim>>& corners, double weight,
-                      std::vector<std::int32_t>& nodes, std::vector<double>& weights) const;
   // A slot of grain g carrying the weighted mean of the velocities of its active `nodes`.
   std::int32_t weighted_slot(std::int32_t g, const std::vector<std::int32_t>& nodes,
                              const std::vector<double>& weights);
-  // Grain-grain contacts at the boundary faces of the points (ContactSettings::grain_faces) for
-  // the pairs sharing nodes, links = (grain A < grain B, A's active node, B's active node);
-  // appends them to the problem and returns the items examined (work count) [-].
-  double grain_face_contacts(std::vector<std::array<std::int32_t, 4>>& links);
   // Velocity of slot s from its grain's current nodal iterate: sum_k w_k v_{a_k} [m/s].
   Vec<Dim> slot_velocity(std::size_t s) const;
   // Nodal impulses of every grain from the slots' impulses slot_P_: P_a = sum_s w_sa P_s.
@@ -205,9 +186,9 @@ class ImplicitSolver {
   std::vector<char> slot_is_face_;
   // Per slot: warm-start key, the global node of a node slot, -1 - cell of a face slot.
   std::vector<std::int64_t> slot_key_;
-  std::vector<std::uint32_t> node_stamp_, slot_stamp_;  // per global node: step stamp
-  std::vector<std::int32_t> node_head_, slot_head_;     // per global node: first entry / slot
-  std::vector<std::int32_t> slot_next_;                 // per slot: next slot at the same node
+  std::vector<std::uint32_t> slot_stamp_;  // per global node: step stamp
+  std::vector<std::int32_t> slot_head_;    // per global node: first slot
+  std::vector<std::int32_t> slot_next_;    // per slot: next slot at the same node
   std::uint32_t stamp_ = 0;
   bool gs_converged_ = true;
   std::vector<WarmImpulse<Dim>> previous_;  // sorted by (node, a, b)
@@ -251,10 +232,9 @@ class ImplicitSolver {
   std::pair<std::size_t, std::size_t> link_sizes() const;
   // Items of the last contact detection on this rank [-].
   double detect_items_ = 0;
-  // Per point: sum_i |F r_i|, a bound of its domain's extent along any direction [m].
-  std::vector<double> point_reach_;
-  // Per point, with face contacts between grains: (F D0)^-1, the inverse of its domain's map [1/m].
-  std::vector<Mat<Dim>> point_dinv_;
+  // Contact detection (its work space kept from step to step) and its views of the grain fields.
+  contact::Detector<Dim> detector_;
+  std::vector<contact::FieldView<Dim>> field_views_;
   double time_ = 0.0;
   double dt_ = 0.0;
   bool step_ready_ = false;
