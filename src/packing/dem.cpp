@@ -6,6 +6,86 @@
 
 namespace mpmcd::packing::detail {
 
+namespace {
+
+// Tangential force of one contact (eq. 4, 4'): f is the force on grain i (on j: -f) [k_n d_mean];
+// n_x_f = n x f, the torque on i per unit lever arm a_i (on j: a_j n x f), a scalar in 2D.
+template <int Dim>
+struct TangentialForce {
+  std::array<double, Dim> f{};
+  std::array<double, Dim == 2 ? 1 : 3> n_x_f{};
+};
+
+// Cundall-Strack tangential spring with Coulomb cap (docs/packing.md eq. 4 in 2D, 4' in 3D):
+// n the unit normal from i to j, dv = v_i - v_j, a_i and a_j the lever arms of the contact point
+// [d_mean], w_i and w_j the spins [1/time], xi the spring (updated in place) [d_mean], cap = mu f_n
+// [k_n d_mean]. The relative velocity of the contact points is v_c = dv + (a_i w_i + a_j w_j) x n
+// (2D: its component along t = (-n_y, n_x) is dv.t + a_i w_i + a_j w_j).
+template <int Dim>
+TangentialForce<Dim> tangential_force(const std::array<double, Dim>& n,
+                                      const std::array<double, Dim>& dv, double a_i, double a_j,
+                                      const std::array<double, Dim == 2 ? 1 : 3>& w_i,
+                                      const std::array<double, Dim == 2 ? 1 : 3>& w_j, double* xi,
+                                      double dt, double kt, double cap) {
+  TangentialForce<Dim> out;
+  if constexpr (Dim == 2) {
+    // Eq. 4: a scalar spring along t = n rotated by +90 degrees.
+    const double tx = -n[1], ty = n[0];
+    const double vt = dv[0] * tx + dv[1] * ty + w_i[0] * a_i + w_j[0] * a_j;
+    double& xit = *xi;
+    xit += vt * dt;
+    double ft = -kt * xit;
+    if (std::abs(ft) > cap) {
+      ft = std::copysign(cap, ft);
+      xit = -ft / kt;
+    }
+    out.f = {ft * tx, ft * ty};
+    out.n_x_f = {ft};  // n x (ft t) = ft
+  } else {
+    const auto cross = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+      return std::array<double, 3>{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                                   a[0] * b[1] - a[1] * b[0]};
+    };
+    const auto dot = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+      return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    };
+    // Eq. 4': v_t = v_c - (v_c . n) n with v_c = dv + (a_i w_i + a_j w_j) x n.
+    std::array<double, 3> w;
+    for (int c = 0; c < 3; ++c) w[c] = a_i * w_i[c] + a_j * w_j[c];
+    const auto wxn = cross(w, n);
+    std::array<double, 3> vc;
+    for (int c = 0; c < 3; ++c) vc[c] = dv[c] + wxn[c];
+    const double vn = dot(vc, n);
+    // The spring of the last step rotated onto the current tangent plane: its normal component
+    // removed and its length kept (Luding, Granular Matter 10 (2008) 235, §2.2; LAMMPS pair
+    // granular, tangential linear_history).
+    const std::array<double, 3> s0{xi[0], xi[1], xi[2]};
+    const double len0 = std::sqrt(dot(s0, s0)), sn = dot(s0, n);
+    std::array<double, 3> s;
+    for (int c = 0; c < 3; ++c) s[c] = s0[c] - sn * n[c];
+    const double len1 = std::sqrt(dot(s, s));
+    const double keep = len1 > 0.0 ? len0 / len1 : 0.0;
+    for (int c = 0; c < 3; ++c) s[c] = keep * s[c] + (vc[c] - vn * n[c]) * dt;
+    // f_t = -k_t xi, capped at mu f_n (Coulomb) with the spring shortened to match.
+    std::array<double, 3> f;
+    for (int c = 0; c < 3; ++c) f[c] = -kt * s[c];
+    const double fl = std::sqrt(dot(f, f));
+    if (fl > cap) {
+      const double shrink = cap / fl;
+      for (int c = 0; c < 3; ++c) {
+        f[c] *= shrink;
+        s[c] = -f[c] / kt;
+      }
+    }
+    for (int c = 0; c < 3; ++c) xi[c] = s[c];
+    out.f = f;
+    out.n_x_f = cross(n, f);
+  }
+  return out;
+}
+
+}  // namespace
+
 template <int Dim>
 Dem<Dim>::Dem(Coords x, std::vector<double> r0, Box box, const DemSettings& settings)
     : s_(settings), box_(box), x_(std::move(x)), r0_(std::move(r0)) {
@@ -14,8 +94,10 @@ Dem<Dim>::Dem(Coords x, std::vector<double> r0, Box box, const DemSettings& sett
     v_[a].assign(n, 0.0);
     f_[a].assign(n, 0.0);
   }
-  w_.assign(n, 0.0);
-  tq_.assign(n, 0.0);
+  for (int c = 0; c < kRot; ++c) {
+    w_[c].assign(n, 0.0);
+    tq_[c].assign(n, 0.0);
+  }
   r_ = r0_;
   m_.resize(n);
   im_.resize(n);
@@ -67,16 +149,17 @@ void Dem<Dim>::wrap() {
 template <int Dim>
 void Dem<Dim>::zero_velocities() {
   for (auto& v : v_) std::fill(v.begin(), v.end(), 0.0);
-  std::fill(w_.begin(), w_.end(), 0.0);
+  for (auto& w : w_) std::fill(w.begin(), w.end(), 0.0);
 }
 
 template <int Dim>
 double Dem<Dim>::kinetic_energy() const {
   double e = 0.0;
   for (std::size_t i = 0; i < size(); ++i) {
-    double v2 = 0.0;
+    double v2 = 0.0, w2 = 0.0;
     for (int a = 0; a < Dim; ++a) v2 += v_[a][i] * v_[a][i];
-    e += 0.5 * m_[i] * v2 + 0.5 * w_[i] * w_[i] / ii_[i];
+    for (int c = 0; c < kRot; ++c) w2 += w_[c][i] * w_[c][i];
+    e += 0.5 * m_[i] * v2 + 0.5 * w2 / ii_[i];
   }
   return e;
 }
@@ -201,13 +284,15 @@ void Dem<Dim>::build_neighbours() {
     std::sort(nb_j_.begin() + static_cast<std::ptrdiff_t>(row), nb_j_.end());
     nb_start_[i + 1] = static_cast<std::int64_t>(nb_j_.size());
   }
-  nb_xi_.assign(nb_j_.size(), 0.0);
+  nb_xi_.assign(nb_j_.size() * kSpring, 0.0);
   if (carry) {
     for (std::size_t i = 0; i < n; ++i) {
       const auto ob = old_j.begin() + old_start[i], oe = old_j.begin() + old_start[i + 1];
       for (std::int64_t k = nb_start_[i]; k < nb_start_[i + 1]; ++k) {
         const auto it = std::lower_bound(ob, oe, nb_j_[k]);
-        if (it != oe && *it == nb_j_[k]) nb_xi_[k] = old_xi[it - old_j.begin()];
+        if (it == oe || *it != nb_j_[k]) continue;
+        const auto old = static_cast<std::size_t>(it - old_j.begin()) * kSpring;
+        for (int c = 0; c < kSpring; ++c) nb_xi_[k * kSpring + c] = old_xi[old + c];
       }
     }
   }
@@ -238,7 +323,7 @@ template <int Dim>
 void Dem<Dim>::compute_forces(bool viscous, double dt) {
   const std::size_t n = size();
   for (auto& f : f_) std::fill(f.begin(), f.end(), 0.0);
-  std::fill(tq_.begin(), tq_.end(), 0.0);
+  for (auto& t : tq_) std::fill(t.begin(), t.end(), 0.0);
   double max_ov = 0.0, energy = 0.0;
   const bool hertz = s_.law == ContactLaw::kHertz;
   const bool friction = s_.friction > 0.0;
@@ -258,7 +343,8 @@ void Dem<Dim>::compute_forces(bool viscous, double dt) {
   for (std::size_t i = 0; i < n; ++i) {
     const double ri = r_[i];
     std::array<double, Dim> fi{};
-    double tqi = 0.0;
+    std::array<double, kRot> tqi{}, wi;
+    for (int c = 0; c < kRot; ++c) wi[c] = w_[c][i];
     for (std::int64_t k = nb_start_[i]; k < nb_start_[i + 1]; ++k) {
       const std::int32_t j = nb_j_[k];
       std::array<double, Dim> dx;
@@ -269,7 +355,7 @@ void Dem<Dim>::compute_forces(bool viscous, double dt) {
       }
       const double rs = ri + r_[j];
       if (d2 >= rs * rs) {
-        nb_xi_[k] = 0.0;
+        for (int c = 0; c < kSpring; ++c) nb_xi_[k * kSpring + c] = 0.0;
         continue;
       }
       const double d = std::sqrt(d2);
@@ -293,30 +379,26 @@ void Dem<Dim>::compute_forces(bool viscous, double dt) {
         fi[a] -= fn * nv[a];
         f_[a][j] += fn * nv[a];
       }
-      if constexpr (Dim == 2) {
-        if (friction) {
-          // Tangential spring with Coulomb cap (eq. 4), t = n rotated by +90 degrees.
-          const double tx = -nv[1], ty = nv[0];
-          const double vt = dv[0] * tx + dv[1] * ty + w_[i] * ri + w_[j] * r_[j];
-          double& xit = nb_xi_[k];
-          xit += vt * dt;
-          double ft = -kt * xit;
-          const double cap = s_.friction * fn;
-          if (std::abs(ft) > cap) {
-            ft = std::copysign(cap, ft);
-            xit = -ft / kt;
-          }
-          fi[0] += ft * tx;
-          fi[1] += ft * ty;
-          f_[0][j] -= ft * tx;
-          f_[1][j] -= ft * ty;
-          tqi += ri * ft;
-          tq_[j] += r_[j] * ft;
+      if (friction) {
+        // Tangential spring with Coulomb cap (eq. 4, 4'). Lever arms of the contact point: the
+        // radii in 2D (eq. 4); in 3D r - delta/2, the contact point in the middle of the overlap
+        // (as YADE's ScGeom), so that a_i + a_j = |x_j - x_i| and the torques conserve the
+        // angular momentum (eq. 4').
+        const double rj = r_[j];
+        const double ai = Dim == 2 ? ri : ri - 0.5 * delta;
+        const double aj = Dim == 2 ? rj : rj - 0.5 * delta;
+        std::array<double, kRot> wj;
+        for (int c = 0; c < kRot; ++c) wj[c] = w_[c][j];
+        const auto t = tangential_force<Dim>(nv, dv, ai, aj, wi, wj, &nb_xi_[k * kSpring], dt, kt,
+                                             s_.friction * fn);
+        for (int a = 0; a < Dim; ++a) {
+          fi[a] += t.f[a];
+          f_[a][j] -= t.f[a];
         }
-      } else {
-        (void)friction;
-        (void)kt;
-        (void)dt;
+        for (int c = 0; c < kRot; ++c) {
+          tqi[c] += ai * t.n_x_f[c];
+          tq_[c][j] += aj * t.n_x_f[c];
+        }
       }
     }
     // Frictionless rigid walls, same normal law with R* = r_i and m* = m_i (§2): wall w is the
@@ -336,10 +418,10 @@ void Dem<Dim>::compute_forces(bool viscous, double dt) {
     if (viscous) {
       // Background drag (eq. 5).
       for (int a = 0; a < Dim; ++a) fi[a] -= s_.global_damping * m_[i] * v_[a][i];
-      tqi -= s_.global_damping * w_[i] / ii_[i];
+      for (int c = 0; c < kRot; ++c) tqi[c] -= s_.global_damping * w_[c][i] / ii_[i];
     }
     for (int a = 0; a < Dim; ++a) f_[a][i] += fi[a];
-    tq_[i] += tqi;
+    for (int c = 0; c < kRot; ++c) tq_[c][i] += tqi[c];
   }
   max_overlap_ = max_ov;
   energy_ = energy;
@@ -356,19 +438,21 @@ void Dem<Dim>::md_step(double dt) {
   // Velocity Verlet (eq. 7); the viscous forces use the half-step velocities.
   const std::size_t n = size();
   if (!built_) update_forces(true);
-  const bool spin = Dim == 2 && s_.friction > 0.0;
+  const bool spin = s_.friction > 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     for (int a = 0; a < Dim; ++a) {
       v_[a][i] += 0.5 * dt * f_[a][i] * im_[i];
       x_[a][i] += dt * v_[a][i];
     }
-    if (spin) w_[i] += 0.5 * dt * tq_[i] * ii_[i];
+    if (spin)
+      for (int c = 0; c < kRot; ++c) w_[c][i] += 0.5 * dt * tq_[c][i] * ii_[i];
   }
   maybe_rebuild();
   compute_forces(true, dt);
   for (std::size_t i = 0; i < n; ++i) {
     for (int a = 0; a < Dim; ++a) v_[a][i] += 0.5 * dt * f_[a][i] * im_[i];
-    if (spin) w_[i] += 0.5 * dt * tq_[i] * ii_[i];
+    if (spin)
+      for (int c = 0; c < kRot; ++c) w_[c][i] += 0.5 * dt * tq_[c][i] * ii_[i];
   }
   ++steps_;
 }

@@ -14,7 +14,7 @@ namespace mpmcd::packing::detail {
 /// Contact and damping settings of the DEM (reduced units).
 struct DemSettings {
   ContactLaw law = ContactLaw::kLinear;  ///< normal force law (eq. 1, 2)
-  double friction = 0.0;                 ///< Coulomb coefficient mu (eq. 4), 2D only [-]
+  double friction = 0.0;                 ///< Coulomb coefficient mu (eq. 4, 3D: eq. 4') [-]
   double tangential_ratio = 0.5;         ///< k_t / k_n (eq. 4) [-]
   double damping_ratio = 0.7;            ///< zeta of eq. 3 [-]
   double global_damping = 0.1;           ///< gamma_g of eq. 5 [1/time]
@@ -40,13 +40,20 @@ double dim_root(double v) {
 }
 
 /// The grain system in Dim = 2 (disks) or 3 (spheres): structure of arrays (one vector per axis),
-/// Verlet neighbour list built from cell lists. Friction (tangential springs, spins) is 2D only.
+/// Verlet neighbour list built from cell lists. With friction, a tangential spring per neighbour
+/// pair and a spin per grain (a scalar in 2D, a 3-vector in 3D; eq. 4, 4').
 template <int Dim>
 class Dem {
  public:
   static_assert(Dim == 2 || Dim == 3);
+  /// Rotational degrees of freedom of a grain: 1 (spin about z) in 2D, 3 in 3D [-].
+  static constexpr int kRot = Dim == 2 ? 1 : 3;
+  /// Components of a tangential spring: 1 (along t = (-n_y, n_x)) in 2D, 3 (a vector) in 3D [-].
+  static constexpr int kSpring = Dim == 2 ? 1 : 3;
   /// Coordinates, one vector per axis [d_mean].
   using Coords = std::array<std::vector<double>, Dim>;
+  /// Angular velocities, one vector per rotational component [1/time].
+  using Spins = std::array<std::vector<double>, kRot>;
   /// Walls {lo_0, .., lo_{Dim-1}, hi_0, .., hi_{Dim-1}} [d_mean] (2D: {xlo, ylo, xhi, yhi}).
   using Box = std::array<double, 2 * Dim>;
 
@@ -89,7 +96,22 @@ class Dem {
 
   /// Centers along axis a [d_mean].
   const std::vector<double>& x(int a) const { return x_[a]; }
+  /// Current radii [d_mean].
   const std::vector<double>& r() const { return r_; }
+  /// Velocities along axis a [d_mean/time].
+  const std::vector<double>& v(int a) const { return v_[a]; }
+  /// Sets the velocities [d_mean/time].
+  void set_velocities(const Coords& v) { v_ = v; }
+  /// Angular velocity component c (2D: the spin about z; 3D: about x, y, z) [1/time].
+  const std::vector<double>& spin(int c) const { return w_[c]; }
+  /// Sets the angular velocities [1/time].
+  void set_spins(const Spins& w) { w_ = w; }
+  /// Net forces along axis a of the last force evaluation [k_n d_mean].
+  const std::vector<double>& f(int a) const { return f_[a]; }
+  /// Mass of grain i (eq. 6) [mass of a grain of diameter d_mean].
+  double mass(std::size_t i) const { return m_[i]; }
+  /// Moment of inertia of grain i (eq. 6) [mass d_mean^2].
+  double inertia(std::size_t i) const { return 1.0 / ii_[i]; }
   /// Positions, for saving/restoring states.
   void get_positions(Coords& x) const { x = x_; }
   void set_positions(const Coords& x);
@@ -116,14 +138,15 @@ class Dem {
   Box box_;
   Box wall_v_{};
   Coords x_, v_, f_;
-  std::vector<double> w_, tq_, r0_, r_, m_, im_, ii_;  // spin and torque: 2D friction only
+  Spins w_, tq_;  // angular velocity and torque (used with friction only)
+  std::vector<double> r0_, r_, m_, im_, ii_;
   double scale_ = 1.0;
   double r0_max_ = 0.0;
   double dt_ = 0.0;
   // Verlet list in CSR form: neighbours j > i of grain i are nb_j_[nb_start_[i] .. [i+1]).
   std::vector<std::int64_t> nb_start_;
   std::vector<std::int32_t> nb_j_;
-  std::vector<double> nb_xi_;  // tangential spring elongation per pair (eq. 4)
+  std::vector<double> nb_xi_;  // tangential spring per pair, kSpring components each (eq. 4, 4')
   Coords ref_x_;
   double ref_scale_ = 0.0;
   std::vector<std::int32_t> cell_start_, cell_items_;

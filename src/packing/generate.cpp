@@ -78,9 +78,6 @@ std::optional<ParamProblem> check_params(const PackingParams& p) {
     return bad("target_phi", fmt::format("a number in (0, 0.9], got {}", p.target_phi));
   if (!std::isfinite(p.friction) || p.friction < 0.0 || p.friction > 10.0)
     return bad("friction", fmt::format("a number in [0, 10], got {}", p.friction));
-  if (three && p.friction != 0.0)
-    return bad("friction",
-               fmt::format("0 in 3D (the sphere DEM is frictionless), got {}", p.friction));
   if (p.periodic && p.method == PackingMethod::kWalls)
     return bad("boundary", "\"walls\" for method \"walls\" (a periodic cell has no walls)");
   if (p.method == PackingMethod::kJam && p.friction != 0.0)

@@ -42,14 +42,15 @@ int pack_command(const std::string& input_path, bool quiet, bool overwrite) {
   // A packing `mpmcd run` would refuse (overlapping disks, docs/robustness.md) is not written:
   // exit 3, as a simulation that cannot go on.
   if (const auto o = find_grain_overlap(packing, kOverlapTolerance)) {
+    const char* grains = packing.dimension == 3 ? "spheres" : "disks";
     fmt::print(stderr,
                "mpmcd pack: {}: the packing did not relax: {} {} and {} overlap by {:.3g} of "
                "the smaller diameter (mpmcd run accepts up to {:g}; largest overlap {:.3g} "
                "d_mean after {} DEM steps, phi = {:.4f}). Nothing written. Lower target_phi or "
-               "friction (frictional disks jam at a lower phi), or raise max_relax_steps.\n",
-               input_path, packing.dimension == 3 ? "spheres" : "disks", packing.disks[o->first].id,
-               packing.disks[o->second].id, o->depth / o->size, kOverlapTolerance,
-               report.max_overlap, report.steps, report.phi);
+               "friction (frictional {} jam at a lower phi), or raise max_relax_steps.\n",
+               input_path, grains, packing.disks[o->first].id, packing.disks[o->second].id,
+               o->depth / o->size, kOverlapTolerance, report.max_overlap, report.steps, report.phi,
+               grains);
     return 3;
   }
   io::claim_output_folder(input.output_folder, earlier, overwrite, what, input_path,

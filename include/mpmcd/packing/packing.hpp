@@ -50,7 +50,7 @@ enum class ContactLaw {
 
 /// Parameters of generate_packing: plain data, SI units. Defaults are those of docs/packing.md §5.
 struct PackingParams {
-  int dimension = 2;              ///< 2: disks, 3: spheres (frictionless only) [-]
+  int dimension = 2;              ///< 2: disks, 3: spheres [-]
   std::int64_t count = 300;       ///< number of disks when `diameters` is empty [-]
   double diameter_min = 0.0;      ///< smallest diameter of the uniform distribution [m]
   double diameter_max = 0.0;      ///< largest diameter of the uniform distribution [m]
@@ -68,7 +68,7 @@ struct PackingParams {
   double target_phi = 0.78;  ///< disk area / box area (3D: volumes) to reach (grow, walls) [-]
   PackingMethod method = PackingMethod::kGrow;   ///< protocol
   ContactLaw contact_law = ContactLaw::kLinear;  ///< normal force law
-  double friction = 0.0;                         ///< Coulomb friction coefficient between disks [-]
+  double friction = 0.0;    ///< Coulomb coefficient between grains (eq. 4, 4') [-]
   bool periodic = false;    ///< periodic cell instead of rigid walls (not with method kWalls)
   std::uint64_t seed = 42;  ///< seed of the std::mt19937_64 generator [-]
   // Numerical settings, in reduced units: length d_mean, stiffness k_n, mass of a disk of

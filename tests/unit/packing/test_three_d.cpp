@@ -251,8 +251,8 @@ TEST(ThreeDPacking, ForeignAndMalformedFiles) {
   EXPECT_EQ(parse_packing_csv("id,x,y,z,radius\n0,0,0,0,1\n1,0,0,2,1\n", "t.csv").disks.size(), 2u);
 }
 
-// The pack input: dimension = 3 with a six-number box / three-number origin; a bad dimension, a
-// 2D box in 3D and friction in 3D are refused naming the file and the key.
+// The pack input: dimension = 3 with a six-number box / three-number origin, friction; a bad
+// dimension, a 2D box in 3D and friction with method "jam" are refused naming the file and the key.
 TEST(ThreeDPacking, PackInputAcceptsDimension3AndNamesBadKeys) {
   const std::string head =
       "[packing]\ndimension = 3\ncount = 40\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
@@ -282,7 +282,13 @@ TEST(ThreeDPacking, PackInputAcceptsDimension3AndNamesBadKeys) {
   refused("[packing]\ndimension = \"3\"\ncount = 4\n", "key 'packing.dimension': an integer");
   refused(head + "box = [0, 0, 0.004, 0.004]\n", "key 'packing.box': an array of 6 numbers");
   refused(head + "aspect_ratio = 1.0\norigin = [0, 0]\n", "key 'packing.origin': an array of 3");
-  refused(head + "aspect_ratio = 1.0\nfriction = 0.2\n", "key 'packing.friction': 0 in 3D");
+  // Friction is accepted in 3D (eq. 4'), not with the (frictionless) jamming search.
+  const auto in3 = parse_packing_input(head + "aspect_ratio = 1.0\nfriction = 0.2\n", "c.toml");
+  EXPECT_EQ(in3.params.friction, 0.2);
+  refused(
+      "[packing]\ndimension = 3\ncount = 40\ndiameter_min = 0.8e-3\ndiameter_max = 1.2e-3\n"
+      "aspect_ratio = 1.0\nmethod = \"jam\"\nfriction = 0.2\n",
+      "key 'packing.friction': 0 for method \"jam\"");
 }
 
 // `mpmcd pack` of a 3D input writes the CSV and the VTU and prints the 3D box; seed_packing of
