@@ -21,6 +21,7 @@
 
 #include "cli_runner.hpp"
 #include "mpmcd/analysis/time_series.hpp"
+#include "scratch.hpp"
 
 namespace mpmcd::test_support::squeeze {
 
@@ -76,7 +77,7 @@ inline DiskRun run_disk(int rh, double lambda, double dt, double speed,
                         const std::string& wall_contact = "nodes") {
   const double h = kRadius / rh, t_end = 0.4 * kRadius / speed;
   const std::string tag = fmt::format("{}_{:g}_{:g}_{:g}_{}", rh, lambda, dt, speed, wall_contact);
-  const fs::path dir = fs::temp_directory_path() / ("mpmcd_squeeze_fe_" + tag);
+  const fs::path dir = mpmcd::test_support::scratch_path("squeeze_fe_" + tag);
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "disk.toml") << fmt::format(

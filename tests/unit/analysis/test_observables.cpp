@@ -12,6 +12,7 @@
 #include <numbers>
 #include <vector>
 
+#include "../../support/scratch.hpp"
 #include "mpmcd/analysis/observables.hpp"
 #include "mpmcd/analysis/time_series.hpp"
 #include "mpmcd/core/errors.hpp"
@@ -234,7 +235,7 @@ TEST(Coordination, FromAContactProblem) {
 }
 
 TEST(TimeSeries, ReadsColumnsAndRefusesGarbage) {
-  const auto dir = std::filesystem::temp_directory_path() / "mpmcd_unit_analysis";
+  const auto dir = mpmcd::test_support::scratch_path("unit_analysis");
   std::filesystem::create_directories(dir);
   const auto good = (dir / "good.csv").string();
   std::ofstream(good) << "time,phi\n0,0.7\n1e-3,7.5e-1\n";

@@ -13,13 +13,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "../../support/scratch.hpp"
 #include "mpmcd/io/vtu.hpp"
 
 namespace fs = std::filesystem;
 
 TEST(WriteFileAtomic, AFailedWriteNamesTheReasonAndLeavesNoTmp) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("mpmcd_test_write_" + std::to_string(::getpid()));
+  const fs::path dir = mpmcd::test_support::scratch_path("test_write");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string path = (dir / "snapshot.vtu").string();

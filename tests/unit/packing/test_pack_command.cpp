@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include "../../support/scratch.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/packing/pack_command.hpp"
 #include "mpmcd/packing/packing.hpp"
@@ -14,7 +15,7 @@ namespace fs = std::filesystem;
 using namespace mpmcd::packing;
 
 TEST(PackCommand, WritesCsvVtuAndSummary) {
-  const auto dir = fs::temp_directory_path() / ("mpmcd_test_pack_" + std::to_string(::getpid()));
+  const auto dir = mpmcd::test_support::scratch_path("test_pack");
   fs::create_directories(dir);
   const auto input = dir / "pack.toml";
   const auto folder = dir / "out";

@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include "../../support/scratch.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/packing/input.hpp"
 #include "mpmcd/packing/overlap.hpp"
@@ -19,7 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path scratch(const std::string& name) {
-  const auto dir = fs::temp_directory_path() / ("mpmcd_test_packing_" + std::to_string(::getpid()));
+  const auto dir = mpmcd::test_support::scratch_path("test_packing");
   fs::create_directories(dir);
   return dir / name;
 }

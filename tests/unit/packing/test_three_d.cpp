@@ -15,6 +15,7 @@
 
 #include <unistd.h>
 
+#include "../../support/scratch.hpp"
 #include "mpmcd/core/errors.hpp"
 #include "mpmcd/packing/input.hpp"
 #include "mpmcd/packing/overlap.hpp"
@@ -102,7 +103,7 @@ void expect_packed(const Packing& pk, const PackingReport& report, double target
 }
 
 fs::path scratch(const std::string& name) {
-  const auto dir = fs::temp_directory_path() / ("mpmcd_test_pack3d_" + std::to_string(::getpid()));
+  const auto dir = mpmcd::test_support::scratch_path("test_pack3d");
   fs::create_directories(dir);
   return dir / name;
 }

@@ -19,12 +19,12 @@
 #include "mpmcd/analysis/time_series.hpp"
 
 #include "../../support/cli_runner.hpp"
+#include "../../support/scratch.hpp"
 
 namespace fs = std::filesystem;
 
 TEST(Compaction3D, TheCiExampleJamsStoresTheWorkAndKeepsTheVolumeIdentity) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("mpmcd_compaction_3d_" + std::to_string(getpid()));
+  const fs::path dir = mpmcd::test_support::scratch_path("compaction_3d");
   fs::remove_all(dir);
   const std::string input =
       std::string(MPMCD_SOURCE_DIR) + "/examples/compaction_3d/compaction_3d_ci.toml";

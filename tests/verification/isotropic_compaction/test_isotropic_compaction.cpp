@@ -17,11 +17,12 @@
 #include "mpmcd/analysis/time_series.hpp"
 
 #include "../../support/cli_runner.hpp"
+#include "../../support/scratch.hpp"
 
 namespace fs = std::filesystem;
 
 TEST(IsotropicCompaction, PhiRisesWithPressureAndTheWallsHoldTheirTargets) {
-  const fs::path dir = fs::temp_directory_path() / ("mpmcd_isotropic_" + std::to_string(getpid()));
+  const fs::path dir = mpmcd::test_support::scratch_path("isotropic");
   fs::remove_all(dir);
   const std::string input =
       std::string(MPMCD_SOURCE_DIR) + "/examples/isotropic_compaction/isotropic_compaction_ci.toml";
@@ -91,8 +92,7 @@ TEST(IsotropicCompaction, PhiRisesWithPressureAndTheWallsHoldTheirTargets) {
 
 // A loading error on the command line: exit 2, the file, line, key and expectation, no output.
 TEST(IsotropicCompaction, ALoadingErrorExits2AndWritesNothing) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("mpmcd_isotropic_bad_" + std::to_string(getpid()));
+  const fs::path dir = mpmcd::test_support::scratch_path("isotropic_bad");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string example =

@@ -17,6 +17,7 @@
 #include "mpmcd/analysis/time_series.hpp"
 
 #include "../../support/cli_runner.hpp"
+#include "../../support/scratch.hpp"
 
 namespace fs = std::filesystem;
 
@@ -46,9 +47,9 @@ mpmcd::analysis::TimeSeries run_stack(int disks, double h, const std::string& co
   text = replace_all(text, "@TOP@", fmt::format("{:.17g}", top));
   text = replace_all(text, "@CELL@", fmt::format("{:.17g}", h));
   text = replace_all(text, "[contact]\n", "[contact]\n" + contact);
-  const fs::path dir =
-      fs::temp_directory_path() / ("mpmcd_mirror_" + std::to_string(disks) + "_" +
-                                   fmt::format("{:.17g}", h) + (contact.empty() ? "" : "_faces"));
+  const fs::path dir = mpmcd::test_support::scratch_path("mirror_" + std::to_string(disks) + "_" +
+                                                         fmt::format("{:.17g}", h) +
+                                                         (contact.empty() ? "" : "_faces"));
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "mirror.toml") << text;
