@@ -7,7 +7,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -21,7 +20,6 @@ namespace mpmcd::test_support {
 class ScratchFolders : public ::testing::Environment {
  public:
   void add(const std::filesystem::path& p) {
-    const std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& q : folders_)
       if (q == p) return;
     folders_.push_back(p);
@@ -41,7 +39,6 @@ class ScratchFolders : public ::testing::Environment {
   }
 
  private:
-  std::mutex mutex_;
   std::vector<std::filesystem::path> folders_;
 };
 

@@ -77,9 +77,7 @@ inline DiskRun run_disk(int rh, double lambda, double dt, double speed,
                         const std::string& wall_contact = "nodes") {
   const double h = kRadius / rh, t_end = 0.4 * kRadius / speed;
   const std::string tag = fmt::format("{}_{:g}_{:g}_{:g}_{}", rh, lambda, dt, speed, wall_contact);
-  const fs::path dir = mpmcd::test_support::scratch_path("squeeze_fe_" + tag);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = mpmcd::test_support::scratch_dir("squeeze_fe", tag);
   std::ofstream(dir / "disk.toml") << fmt::format(
       "[simulation]\nname = \"disk\"\n"
       "[grid]\norigin = [-2e-3, -1.5e-3]\nextent = [4e-3, 3e-3]\ncell_size = {:.17g}\n"

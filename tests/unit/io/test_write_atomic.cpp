@@ -19,9 +19,7 @@
 namespace fs = std::filesystem;
 
 TEST(WriteFileAtomic, AFailedWriteNamesTheReasonAndLeavesNoTmp) {
-  const fs::path dir = mpmcd::test_support::scratch_path("test_write");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = mpmcd::test_support::scratch_dir("test", "write");
   const std::string path = (dir / "snapshot.vtu").string();
   mpmcd::io::write_file_atomic(path, "old\n");
   // A file-size limit stands in for a full disk: write(2) fails (EFBIG instead of ENOSPC; the

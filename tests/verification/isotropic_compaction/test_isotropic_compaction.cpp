@@ -92,9 +92,7 @@ TEST(IsotropicCompaction, PhiRisesWithPressureAndTheWallsHoldTheirTargets) {
 
 // A loading error on the command line: exit 2, the file, line, key and expectation, no output.
 TEST(IsotropicCompaction, ALoadingErrorExits2AndWritesNothing) {
-  const fs::path dir = mpmcd::test_support::scratch_path("isotropic_bad");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = mpmcd::test_support::scratch_dir("isotropic", "bad");
   const std::string example =
       std::string(MPMCD_SOURCE_DIR) + "/examples/isotropic_compaction/isotropic_compaction_ci.toml";
   std::ifstream in(example);

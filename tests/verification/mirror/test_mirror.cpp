@@ -47,11 +47,9 @@ mpmcd::analysis::TimeSeries run_stack(int disks, double h, const std::string& co
   text = replace_all(text, "@TOP@", fmt::format("{:.17g}", top));
   text = replace_all(text, "@CELL@", fmt::format("{:.17g}", h));
   text = replace_all(text, "[contact]\n", "[contact]\n" + contact);
-  const fs::path dir = mpmcd::test_support::scratch_path("mirror_" + std::to_string(disks) + "_" +
-                                                         fmt::format("{:.17g}", h) +
-                                                         (contact.empty() ? "" : "_faces"));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = mpmcd::test_support::scratch_dir(
+      "mirror",
+      std::to_string(disks) + "_" + fmt::format("{:.17g}", h) + (contact.empty() ? "" : "_faces"));
   std::ofstream(dir / "mirror.toml") << text;
   const auto r = mpmcd::test_support::run("run -q -t 1 " + (dir / "mirror.toml").string() + " -o " +
                                           (dir / "out").string());
