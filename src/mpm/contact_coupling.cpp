@@ -254,6 +254,7 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
 
 template <int Dim>
 double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
+  if (distributed()) return update_contacts_distributed(stats);  // lumped, Gauss-Seidel
   // Response of each grain: its compliance group (exact, linearised) or the lumped 1/m_I.
   const auto ngroups = static_cast<std::int64_t>(problem_.groups.size());
   if (!slot_bases_valid_) build_slot_bases();

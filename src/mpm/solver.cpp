@@ -72,13 +72,12 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     work_.clear();
     for (std::size_t g = 0; g < ng; ++g) work_.push_back(std::make_unique<GrainWork>());
   }
-  // The grains this rank computes (all of them when serial); ghosts are added by exchange_entries.
-  const bool dist = distributed();
+  // The grains this rank computes (all of them on one rank); ghosts are added by exchange_entries.
   if (owner_.size() != ng) owner_.assign(ng, 0);
   owned_.clear();
   role_.assign(ng, 0);
   for (std::size_t g = 0; g < ng; ++g)
-    if (!dist || owner_[g] == comm_->rank()) {
+    if (owner_[g] == comm_->rank()) {
       owned_.push_back(g);
       role_[g] = 1;
     }
@@ -98,8 +97,8 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     return false;
   };
   auto collect_failure = [&]() {
-    const bool failed = local_failure();
-    return dist ? sync_failure(stats) : failed;
+    local_failure();
+    return sync_failure(stats);
   };
   {
     ScopedStage t(&timers_, "p2g");
@@ -123,23 +122,14 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     phase_work(g, 0) += parallel::cost::kSetup * static_cast<double>(grains_[g].size());
     owned_points += static_cast<double>(grains_[g].size());
   }
-  if (dist) comm_->count_work(parallel::cost::kP2g * owned_points);
+  comm_->count_work(parallel::cost::kP2g * owned_points);
   if (collect_failure()) return stats;
-  const bool contact = settings_.contact.enabled;
-  if (contact && dist) {
-    ScopedStage t(&timers_, "comm.entries");
-    exchange_entries();
-  }
-  if (contact) {
+  if (settings_.contact.enabled) {
+    exchange_entries();  // the ghost grains' contact nodes (none on one rank)
     ScopedStage t(&timers_, "contact.detect");
     detect_contacts(dt);
-    if (dist) {
-      comm_->count_work(parallel::cost::kDetectItem * detect_items_);
-      ScopedStage tc(&timers_, "contact.detect.comm");
-      exchange_requests();
-    } else {
-      have_contacts_ = !problem_.contacts.empty();
-    }
+    comm_->count_work(parallel::cost::kDetectItem * detect_items_);
+    exchange_requests();  // the ghost slots' links, and whether any rank has contacts
   } else {
     problem_.contacts.clear();
     problem_.slots.clear();
@@ -172,7 +162,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         phase_work(g, it) += u;
         units += u;
       }
-      if (dist) comm_->count_work(units);
+      comm_->count_work(units);
     }
     const bool failed_here = local_failure();
     // Convergence of each evaluated grain: |R| <= tol * reference and |dv|_M <= tol * velocity
@@ -189,19 +179,16 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       ref_scale = std::max(ref_scale, work_[g]->res_ref);
       vel_scale = std::max(vel_scale, work_[g]->vel_ref);
     }
-    if (dist) {
+    {
       // One reduction for the scales (max is exact: the same scales as one process) and the
       // failures: the lowest failing grain over the ranks, as the largest of its negatives.
       constexpr double kNoGrain = 1e300;
-      ScopedStage tc(&timers_, "newton.check.comm");
       std::vector<double> sc{ref_scale, vel_scale,
                              failed_here ? -static_cast<double>(stats.grain) : -kNoGrain};
-      comm_->max(sc);
+      over_ranks(sc, &parallel::Comm::max);
       ref_scale = sc[0];
       vel_scale = sc[1];
       if (sc[2] > -kNoGrain && sync_failure(stats, static_cast<std::int64_t>(-sc[2]))) return stats;
-    } else if (failed_here) {
-      return stats;
     }
     double worst = 0, worst_increment = 0;
     bool all = true;
@@ -226,10 +213,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
       }
       all = all && w.converged;
     }
-    if (dist) {
-      ScopedStage tc(&timers_, "newton.check.comm");
+    {
       std::vector<double> r{worst, all ? 0.0 : 1.0};
-      comm_->max(r);
+      over_ranks(r, &parallel::Comm::max);
       worst = r[0];
       all = r[1] == 0.0;
     }
@@ -268,12 +254,12 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         phase_work(g, it) += u;
         units += u;
       }
-      if (dist) comm_->count_work(units);
+      comm_->count_work(units);
     }
     if (collect_failure()) return stats;
     if (have_contacts_) {
       ScopedStage t(&timers_, "contact.solve");
-      impulse_change = dist ? update_contacts_distributed(stats) : update_contacts(stats);
+      impulse_change = update_contacts(stats);
     }
   }
   for (std::size_t g : owned_) {
@@ -289,13 +275,10 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         stats.grain = static_cast<std::int64_t>(g);
         break;
       }
-    if (dist) {
-      ScopedStage tc(&timers_, "newton.check.comm");
-      std::vector<std::int64_t> gmin{stats.grain < 0 ? std::numeric_limits<std::int64_t>::max()
-                                                     : stats.grain};
-      comm_->min(gmin);
-      stats.grain = gmin[0] == std::numeric_limits<std::int64_t>::max() ? -1 : gmin[0];
-    }
+    std::vector<std::int64_t> gmin{stats.grain < 0 ? std::numeric_limits<std::int64_t>::max()
+                                                   : stats.grain};
+    over_ranks(gmin, &parallel::Comm::min);
+    stats.grain = gmin[0] == std::numeric_limits<std::int64_t>::max() ? -1 : gmin[0];
     stats.failure =
         fmt::format("Newton did not converge in {} iterations (relative residual {:.3e}",
                     settings_.max_iterations,
@@ -346,10 +329,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     ledger[4 * g + 2] = dt * work_int;
     ledger[4 * g + 3] = dt * work_ext;
   }
-  if (dist) {
-    ScopedStage tc(&timers_, "newton.check.comm");
-    comm_->sum(ledger);  // one rank owns each grain: the sum is exact
-  }
+  over_ranks(ledger, &parallel::Comm::sum);  // one rank owns each grain: the sum is exact
   for (std::size_t g = 0; g < grains_.size(); ++g) {
     stats.contact_work += ledger[4 * g];
     stats.transfer_loss += ledger[4 * g + 1];
@@ -373,14 +353,13 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     const std::int32_t a = c.a < 0 ? -1 - c.wall : problem_.slots[c.a].grain;
     previous_.push_back({slot_key_[c.b], a, problem_.slots[c.b].grain, c.impulse});
   }
-  if (dist) {  // sums over the ranks' contacts, added in rank order
-    ScopedStage tc(&timers_, "newton.check.comm");
+  {  // sums over the ranks' contacts, added in rank order
     std::vector<std::int64_t> n{
         stats.contacts,       stats.active_contacts,          stats.linear_solves,
         stats.factorizations, stats.projected_factorizations, stats.shrunk_domains};
-    comm_->sum(n);
+    over_ranks(n, &parallel::Comm::sum);
     std::vector<std::int64_t> it{-stats.iterations};
-    comm_->min(it);
+    over_ranks(it, &parallel::Comm::min);
     stats.contacts = n[0];
     stats.active_contacts = n[1];
     stats.linear_solves = n[2];
@@ -388,7 +367,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.projected_factorizations = n[4];
     stats.shrunk_domains = n[5];
     stats.iterations = static_cast<int>(-it[0]);
-    if (nw > 0) comm_->sum(wall_f);  // one rank holds each grain's wall contacts: exact
+    over_ranks(wall_f, &parallel::Comm::sum);  // one rank holds each grain's wall contacts: exact
   }
   stats.wall_force.assign(nw, {0.0, 0.0, 0.0});
   for (std::size_t g = 0; g < grains_.size(); ++g)

@@ -29,7 +29,7 @@ void ImplicitSolver<Dim>::set_distribution(const parallel::Comm* comm, std::vect
                                            parallel::Scheme scheme) {
   if (owner.size() != grains_.size())
     throw std::invalid_argument("ImplicitSolver::set_distribution: one owner per grain");
-  comm_ = comm;
+  comm_ = comm != nullptr ? comm : &parallel::Comm::alone();
   owner_ = std::move(owner);
   scheme_ = scheme;
   if (distributed() && settings_.contact.enabled && settings_.contact.wall_points)
@@ -72,7 +72,8 @@ double& ImplicitSolver<Dim>::phase_work(std::size_t g, int iteration) {
 template <int Dim>
 bool ImplicitSolver<Dim>::sync_failure(StepStats& stats, std::int64_t lowest) {
   // The lowest failing grain over all ranks (reduced here unless given), its message from its
-  // owner.
+  // owner; on one rank, this rank's failure as it is.
+  if (!distributed()) return !stats.failure.empty();
   ScopedStage tc(&timers_, "newton.check.comm");
   constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
   std::vector<std::int64_t> g{lowest};
@@ -99,6 +100,8 @@ bool ImplicitSolver<Dim>::sync_failure(StepStats& stats, std::int64_t lowest) {
 
 template <int Dim>
 void ImplicitSolver<Dim>::exchange_entries() {
+  if (!distributed()) return;
+  ScopedStage t(&timers_, "comm.entries");
   // 1. Node boxes of every grain (each rank sends its own: a few integers per grain).
   const int me = comm_->rank(), np = comm_->size();
   const std::size_t ng = grains_.size();
@@ -259,6 +262,11 @@ template <int Dim>
 void ImplicitSolver<Dim>::exchange_requests() {
   // The slots of ghost grains in this rank's contacts: ask their owners for their velocities
   // every iteration, and hand them the warm-start impulse (owners then serve those slots).
+  if (!distributed()) {
+    have_contacts_ = !problem_.contacts.empty();
+    return;
+  }
+  ScopedStage tc(&timers_, "contact.detect.comm");
   std::vector<std::int64_t> count{static_cast<std::int64_t>(problem_.contacts.size())};
   comm_->sum(count);
   have_contacts_ = count[0] > 0;

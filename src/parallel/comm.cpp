@@ -208,6 +208,11 @@ Comm& Comm::world() {
   return comm;
 }
 
+const Comm& Comm::alone() {
+  static const Comm comm{AloneTag{}};
+  return comm;
+}
+
 void Comm::finalize() {
 #ifdef MPMCD_WITH_MPI
   int init = 0, fin = 0;

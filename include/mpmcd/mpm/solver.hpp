@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <source_location>
 #include <string>
 #include <vector>
 
@@ -100,7 +101,7 @@ class ImplicitSolver {
   /// Replaces the work counts (a restart; 0 for grains of other ranks) [-].
   void set_grain_work(std::vector<double> work) { grain_work_ = std::move(work); }
   /// True when the step runs on more than one rank.
-  bool distributed() const { return comm_ != nullptr && comm_->size() > 1; }
+  bool distributed() const { return comm_->size() > 1; }
   /// Sets the time t^n [s] of the next step (wall positions).
   void set_time(double t) { time_ = t; }
   /// Replaces the rigid walls (their positions and velocities for the next step; same count and
@@ -144,6 +145,9 @@ class ImplicitSolver {
   // contact.detect: the step's slots and contacts (contact::Detector on views of the grain
   // fields), their warm start and the compliance groups.
   void detect_contacts(double dt);
+  // contact.solve: the contact problem with the grains' current iterates, the new impulses
+  // applied to the grains; returns the relative impulse change [-]. On several ranks, the
+  // distributed Gauss-Seidel (update_contacts_distributed).
   double update_contacts(StepStats& stats);
   std::int32_t slot_of(std::int32_t g, std::int32_t a);
   // A slot of grain g carrying the weighted mean of the velocities of its active `nodes`.
@@ -158,9 +162,24 @@ class ImplicitSolver {
   bool sync_failure(StepStats& stats, std::int64_t lowest = -1);
   // Sorts warm-start impulses by (node, a, b) and keeps one per contact.
   static void sort_unique(std::vector<WarmImpulse<Dim>>& impulses);
+  // The ghost grains' node boxes and contact nodes from their owners (local_ gains the ghosts);
+  // nothing on one rank.
   void exchange_entries();
+  // The ghost slots of this rank's contacts: the links to their owners, and have_contacts_ (any
+  // rank has contacts).
   void exchange_requests();
   double update_contacts_distributed(StepStats& stats);
+  // Reduces `values` element-wise over the ranks with `op` (parallel::Comm::sum, max or min; `at`
+  // names the call site in the synchronisation report), timed as newton.check.comm; nothing to do
+  // on one rank.
+  template <class T>
+  void over_ranks(std::vector<T>& values,
+                  void (parallel::Comm::*op)(std::vector<T>&, std::source_location) const,
+                  std::source_location at = std::source_location::current()) {
+    if (!distributed()) return;
+    ScopedStage tc(&timers_, "newton.check.comm");
+    (comm_->*op)(values, at);
+  }
   grid::Grid<Dim> grid_;
   Settings<Dim> settings_;
   points::PointSet<Dim>& points_;
@@ -195,7 +214,9 @@ class ImplicitSolver {
   // Distribution (docs/parallel.md): owner rank per grain, this rank's grains, ghost grains (their
   // contact nodes received from their owners), the neighbour ranks and, per neighbour, the slots
   // whose velocity / impulse travel each Newton iteration.
-  const parallel::Comm* comm_ = nullptr;
+  // The ranks of the step: parallel::Comm::alone() until set_distribution (every collective and
+  // exchange of the step is then a no-op, so that solve_step runs one code on any rank count).
+  const parallel::Comm* comm_ = &parallel::Comm::alone();
   parallel::Scheme scheme_ = parallel::Scheme::kPartition;
   std::vector<int> owner_;
   std::vector<std::size_t> owned_, local_;  // owned grains; owned + ghost grains (ascending)

@@ -46,6 +46,9 @@ class Comm {
  public:
   /// The world communicator; initialises MPI on first use (a singleton without mpirun).
   static Comm& world();
+  /// A communicator of this process alone (one rank, never touches MPI): the serial runs' comm,
+  /// on which every collective and exchange below is a no-op.
+  static const Comm& alone();
   /// Finalises MPI (call once at the end of main; later calls do nothing).
   static void finalize();
   /// This process's rank [-].
@@ -128,6 +131,8 @@ class Comm {
 
  private:
   Comm();
+  struct AloneTag {};
+  explicit Comm(AloneTag) {}
   friend class SyncMark;
   // Records the arrival at a synchronisation (work interval since the last one) [s].
   void arrive(const std::source_location& at) const;

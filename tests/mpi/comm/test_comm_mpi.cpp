@@ -118,3 +118,32 @@ int main(int argc, char** argv) {
   ::testing::AddGlobalTestEnvironment(new CommEnvironment);
   return RUN_ALL_TESTS();
 }
+
+// Comm::alone() is this process by itself whatever the job's rank count (the serial solver's
+// comm): every collective leaves the values as they are, exchanges receive nothing, and it does
+// not count bytes or messages.
+TEST(CommOnAnyRanks, AloneIsOneRankOnAnyRankCount) {
+  const Comm& alone = Comm::alone();
+  EXPECT_EQ(alone.size(), 1);
+  EXPECT_EQ(alone.rank(), 0);
+  EXPECT_EQ(&alone, &Comm::alone());
+  std::vector<double> d{1.5, -2.0};
+  alone.sum(d);
+  alone.max(d);
+  EXPECT_EQ(d, (std::vector<double>{1.5, -2.0}));
+  std::vector<std::int64_t> i{3, -4};
+  alone.sum(i);
+  alone.min(i);
+  EXPECT_EQ(i, (std::vector<std::int64_t>{3, -4}));
+  const std::vector<char> mine{'a', 'b'};
+  const auto all = alone.allgather(mine);
+  ASSERT_EQ(all.size(), 1u);
+  EXPECT_EQ(all[0], mine);
+  std::vector<char> bytes{'x'};
+  alone.broadcast(bytes, 0);
+  EXPECT_EQ(bytes, std::vector<char>{'x'});
+  EXPECT_TRUE(alone.exchange({}, {}).empty());
+  alone.barrier();
+  EXPECT_EQ(alone.bytes_sent(), 0);
+  EXPECT_EQ(alone.messages_sent(), 0);
+}
