@@ -1,9 +1,12 @@
 #!/bin/bash
 # Refactoring check (issue 15, docs/parallel.md): runs a set of short inputs (serial examples cut
 # with --stop-after, the MPI tests' inputs on 1 and 2 ranks, both schemes) with two mpmcd binaries
-# and compares every CSV, VTU and checkpoint byte for byte (the timers' CSV only by stage names).
+# and compares every CSV, VTU and PVD byte for byte, the checkpoints' datasets with h5dump
+# (Debian hdf5-tools) but for /meta/mpmcd_version (the binary's name), and the timers' CSV only
+# by stage names.
 # Usage: tools/same_outputs.sh OLD_BINARY NEW_BINARY [WORKDIR]; exit 0 when all are identical.
 set -u
+command -v h5dump >/dev/null || { echo "same_outputs.sh: h5dump not found (apt-get install hdf5-tools)" >&2; exit 2; }
 old=$1; new=$2; work=${3:-/tmp/mpmcd_same_outputs}
 root=$(cd "$(dirname "$0")/.." && pwd)
 mpirun_cmd=(mpirun --oversubscribe -np 2)
@@ -36,12 +39,18 @@ status=0
 if ! cmp -s "$work/old/rc.txt" "$work/new/rc.txt"; then
   echo "exit codes differ:"; paste "$work/old/rc.txt" "$work/new/rc.txt"; status=1
 fi
+dump() {  # dump FOLDER FILE: the checkpoint's datasets as text, without /meta/mpmcd_version
+  (cd "$1" && h5dump "$2") | sed '/DATASET "mpmcd_version"/,/^      }$/d'
+}
 files=0
 while IFS= read -r f; do
   rel=${f#"$work/old/"}
   files=$((files + 1))
   if [[ $rel == *_timers.csv ]]; then
     cmp -s <(cut -d, -f1 "$f") <(cut -d, -f1 "$work/new/$rel") || { echo "timer stages differ: $rel"; status=1; }
+  elif [[ $rel == *.h5 ]]; then
+    cmp -s <(dump "$work/old" "$rel") <(dump "$work/new" "$rel") ||
+      { echo "checkpoint differs: $rel"; status=1; }
   elif ! cmp -s "$f" "$work/new/$rel"; then
     echo "differs: $rel"; status=1
   fi
