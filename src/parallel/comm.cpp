@@ -344,6 +344,24 @@ std::vector<std::vector<char>> Comm::allgather(const std::vector<char>& mine,
   return out;
 }
 
+std::vector<std::vector<char>> Comm::gather(const std::vector<char>& mine, int root,
+                                            std::source_location at) const {
+  std::map<int, Buffer> out;
+  std::vector<int> from;
+  if (rank_ != root) {
+    out[root].bytes() = mine;
+  } else {
+    for (int r = 0; r < size_; ++r)
+      if (r != root) from.push_back(r);
+  }
+  auto in = exchange(out, from, at);
+  if (rank_ != root) return {};
+  std::vector<std::vector<char>> all(static_cast<std::size_t>(size_));
+  for (auto& [r, b] : in) all[static_cast<std::size_t>(r)] = std::move(b.bytes());
+  all[static_cast<std::size_t>(root)] = mine;
+  return all;
+}
+
 void Comm::broadcast(std::vector<char>& bytes, int root,
                      [[maybe_unused]] std::source_location at) const {
 #ifdef MPMCD_WITH_MPI

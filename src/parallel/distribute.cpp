@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <set>
 #include <tuple>
+#include <type_traits>
 
 namespace mpmcd::parallel {
 
@@ -26,64 +27,53 @@ std::vector<int> deal_grains(const points::PointSet<Dim>& points,
                                    : bisection(centroids, count, ranks);
 }
 
+namespace {
+// Appends / reads the committed state of grain g (PointSet::for_each_state_field, then history).
+template <int Dim>
+void put_grain(Buffer& b, const points::PointSet<Dim>& points,
+               const std::vector<points::Grain>& grains, std::size_t g) {
+  const std::int64_t h1 = g + 1 < grains.size() ? grains[g + 1].history_offset
+                                                : static_cast<std::int64_t>(points.history.size());
+  for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p)
+    points::PointSet<Dim>::for_each_state_field(points,
+                                                [&](const auto& field) { b.put(field[p]); });
+  for (std::int64_t k = grains[g].history_offset; k < h1; ++k) b.put(points.history[k]);
+}
+template <int Dim>
+void get_grain(Buffer& b, points::PointSet<Dim>& points, const std::vector<points::Grain>& grains,
+               std::size_t g) {
+  const std::int64_t h1 = g + 1 < grains.size() ? grains[g + 1].history_offset
+                                                : static_cast<std::int64_t>(points.history.size());
+  for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p)
+    points::PointSet<Dim>::for_each_state_field(points, [&](auto& field) {
+      field[p] = b.template get<typename std::decay_t<decltype(field)>::value_type>();
+    });
+  for (std::int64_t k = grains[g].history_offset; k < h1; ++k)
+    points.history[k] = b.template get<double>();
+}
+}  // namespace
+
 template <int Dim>
 void gather_points(const Comm& comm, points::PointSet<Dim>& points,
                    const std::vector<points::Grain>& grains, const std::vector<int>& owner,
                    int root) {
   if (comm.size() == 1) return;
-  const auto history_end = [&](std::size_t g) {
-    return g + 1 < grains.size() ? grains[g + 1].history_offset
-                                 : static_cast<std::int64_t>(points.history.size());
-  };
   Buffer mine;
-  for (std::size_t g = 0; g < grains.size(); ++g) {
-    if (owner[g] != comm.rank()) continue;
-    for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
-      mine.put(points.x[p]);
-      mine.put(points.v[p]);
-      mine.put(points.L[p]);
-      mine.put(points.F[p]);
-      mine.put(points.sigma[p]);
-      mine.put(points.sigma_zz[p]);
-      mine.put(points.volume[p]);
-    }
-    for (std::int64_t k = grains[g].history_offset; k < history_end(g); ++k)
-      mine.put(points.history[k]);
-  }
+  for (std::size_t g = 0; g < grains.size(); ++g)
+    if (owner[g] == comm.rank()) put_grain(mine, points, grains, g);
   std::vector<std::vector<char>> all;
   if (root < 0) {
     all = comm.allgather(mine.bytes());
   } else {
-    // Point-to-point to the root (no collective over all ranks but the root's receives).
-    std::map<int, Buffer> out;
-    std::vector<int> from;
-    if (comm.rank() != root) out[root] = mine;
-    if (comm.rank() == root)
-      for (int r = 0; r < comm.size(); ++r)
-        if (r != root) from.push_back(r);
-    auto in = comm.exchange(out, from);
+    all = comm.gather(mine.bytes(), root);
     if (comm.rank() != root) return;
-    all.resize(comm.size());
-    for (auto& [r, b] : in) all[r] = std::move(b.bytes());
   }
   for (int r = 0; r < comm.size(); ++r) {
     if (r == comm.rank()) continue;
     Buffer b;
     b.bytes() = std::move(all[r]);
-    for (std::size_t g = 0; g < grains.size(); ++g) {
-      if (owner[g] != r) continue;
-      for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
-        points.x[p] = b.template get<Vec<Dim>>();
-        points.v[p] = b.template get<Vec<Dim>>();
-        points.L[p] = b.template get<Mat<Dim>>();
-        points.F[p] = b.template get<Mat<Dim>>();
-        points.sigma[p] = b.template get<Mat<Dim>>();
-        points.sigma_zz[p] = b.template get<double>();
-        points.volume[p] = b.template get<double>();
-      }
-      for (std::int64_t k = grains[g].history_offset; k < history_end(g); ++k)
-        points.history[k] = b.template get<double>();
-    }
+    for (std::size_t g = 0; g < grains.size(); ++g)
+      if (owner[g] == r) get_grain(b, points, grains, g);
   }
 }
 
@@ -123,16 +113,13 @@ contact::Problem<Dim> gather_contacts(const Comm& comm, const contact::Problem<D
   if (comm.size() == 1) {
     read(mine);
   } else {
-    std::map<int, Buffer> out;
-    std::vector<int> from;
-    if (comm.rank() != root) out[root] = mine;
-    if (comm.rank() == root)
-      for (int r = 0; r < comm.size(); ++r)
-        if (r != root) from.push_back(r);
-    auto in = comm.exchange(out, from);
+    auto all = comm.gather(mine.bytes(), root);
     if (comm.rank() != root) return {};
-    in[root] = mine;
-    for (auto& [r, b] : in) read(b);
+    for (auto& bytes : all) {
+      Buffer b;
+      b.bytes() = std::move(bytes);
+      read(b);
+    }
   }
   std::stable_sort(rows.begin(), rows.end(), [](const Row& x, const Row& y) {
     return std::tie(x.node, x.body_a, x.grain_b) < std::tie(y.node, y.body_a, y.grain_b);
@@ -169,43 +156,6 @@ contact::Problem<Dim> gather_contacts(const Comm& comm, const contact::Problem<D
 
 template contact::Problem<2> gather_contacts<2>(const Comm&, const contact::Problem<2>&, int);
 template contact::Problem<3> gather_contacts<3>(const Comm&, const contact::Problem<3>&, int);
-
-namespace {
-// Appends / reads the committed state of grain g (x, v, L, F, sigma, sigma_zz, volume, history).
-template <int Dim>
-void put_grain(Buffer& b, const points::PointSet<Dim>& points,
-               const std::vector<points::Grain>& grains, std::size_t g) {
-  const std::int64_t h1 = g + 1 < grains.size() ? grains[g + 1].history_offset
-                                                : static_cast<std::int64_t>(points.history.size());
-  for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
-    b.put(points.x[p]);
-    b.put(points.v[p]);
-    b.put(points.L[p]);
-    b.put(points.F[p]);
-    b.put(points.sigma[p]);
-    b.put(points.sigma_zz[p]);
-    b.put(points.volume[p]);
-  }
-  for (std::int64_t k = grains[g].history_offset; k < h1; ++k) b.put(points.history[k]);
-}
-template <int Dim>
-void get_grain(Buffer& b, points::PointSet<Dim>& points, const std::vector<points::Grain>& grains,
-               std::size_t g) {
-  const std::int64_t h1 = g + 1 < grains.size() ? grains[g + 1].history_offset
-                                                : static_cast<std::int64_t>(points.history.size());
-  for (std::int64_t p = grains[g].begin; p < grains[g].end; ++p) {
-    points.x[p] = b.template get<Vec<Dim>>();
-    points.v[p] = b.template get<Vec<Dim>>();
-    points.L[p] = b.template get<Mat<Dim>>();
-    points.F[p] = b.template get<Mat<Dim>>();
-    points.sigma[p] = b.template get<Mat<Dim>>();
-    points.sigma_zz[p] = b.template get<double>();
-    points.volume[p] = b.template get<double>();
-  }
-  for (std::int64_t k = grains[g].history_offset; k < h1; ++k)
-    points.history[k] = b.template get<double>();
-}
-}  // namespace
 
 template <int Dim>
 double rebalance(const Comm& comm, points::PointSet<Dim>& points,

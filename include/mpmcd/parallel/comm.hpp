@@ -78,6 +78,11 @@ class Comm {
   std::vector<std::vector<char>> allgather(
       const std::vector<char>& mine,
       std::source_location at = std::source_location::current()) const;
+  /// Every rank's bytes at `root`, indexed by rank (its own included), point-to-point (no
+  /// collective over the other ranks); empty on the other ranks.
+  std::vector<std::vector<char>> gather(
+      const std::vector<char>& mine, int root,
+      std::source_location at = std::source_location::current()) const;
   /// Root's bytes on every rank.
   void broadcast(std::vector<char>& bytes, int root,
                  std::source_location at = std::source_location::current()) const;

@@ -36,6 +36,19 @@ struct PointSet {
 
   /// Number of points.
   std::size_t size() const { return x.size(); }
+  /// Calls f on each per-point array that a committed step changes, in this fixed order: x, v,
+  /// L, F, sigma, sigma_zz, volume (what a grain's owner sends to the other ranks: the one list
+  /// of them, parallel/distribute.cpp). `Set` is PointSet<Dim> or const PointSet<Dim>.
+  template <class Set, class Fn>
+  static void for_each_state_field(Set& set, Fn&& f) {
+    f(set.x);
+    f(set.v);
+    f(set.L);
+    f(set.F);
+    f(set.sigma);
+    f(set.sigma_zz);
+    f(set.volume);
+  }
   /// Appends a point with F = I and zero stress; `dom` holds its reference domain's half-edge
   /// vectors as columns [m].
   void add(const Vec<Dim>& pos, const Vec<Dim>& vel, double m, double vol, const Mat<Dim>& dom,

@@ -147,3 +147,23 @@ TEST(CommOnAnyRanks, AloneIsOneRankOnAnyRankCount) {
   EXPECT_EQ(alone.bytes_sent(), 0);
   EXPECT_EQ(alone.messages_sent(), 0);
 }
+
+// gather: every rank's bytes at the root, indexed by rank, the root's own included; nothing
+// elsewhere. Each root in turn.
+TEST(CommOnAnyRanks, GatherGivesTheRootEveryRanksBytes) {
+  const Comm& comm = Comm::world();
+  const int R = comm.size();
+  const std::vector<char> mine(static_cast<std::size_t>(comm.rank() + 1),
+                               static_cast<char>('a' + comm.rank()));
+  for (int root = 0; root < R; ++root) {
+    const auto all = comm.gather(mine, root);
+    if (comm.rank() != root) {
+      EXPECT_TRUE(all.empty());
+      continue;
+    }
+    ASSERT_EQ(all.size(), static_cast<std::size_t>(R));
+    for (int r = 0; r < R; ++r)
+      EXPECT_EQ(all[static_cast<std::size_t>(r)],
+                std::vector<char>(static_cast<std::size_t>(r + 1), static_cast<char>('a' + r)));
+  }
+}
