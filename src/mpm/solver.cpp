@@ -143,26 +143,34 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     return w.dv_from_contact ? contact_increment_tolerance * vel_scale
                              : settings_.increment_tolerance * vref;
   };
+  // Runs `stage(g, w)` on the threads for each grain of this rank still iterating (neither
+  // converged nor failed) and counts the work units it returns, per grain and phase of iteration
+  // `it` and for this rank (Comm::count_work).
+  const auto on_open_grains = [&](int it, auto&& stage) {
+    double units = 0;
+    const ThreadedRegion threaded(&timers_, no > 1);
+#pragma omp parallel for schedule(dynamic, 1) if (no > 1) reduction(+ : units)
+    for (std::size_t i = 0; i < no; ++i) {
+      const std::size_t g = owned_[i];
+      GrainWork& w = *work_[g];
+      if (w.converged || !w.failure.empty()) continue;
+      const double u = stage(g, w);
+      phase_work(g, it) += u;
+      units += u;
+    }
+    comm_->count_work(units);
+  };
   for (int it = 0; it <= settings_.max_iterations; ++it) {
     {
       ScopedStage t(&timers_, "newton.assemble");
-      double units = 0;
-      const ThreadedRegion threaded(&timers_, no > 1);
-#pragma omp parallel for schedule(dynamic, 1) if (no > 1) reduction(+ : units)
-      for (std::size_t i = 0; i < no; ++i) {
-        const std::size_t g = owned_[i];
-        GrainWork& w = *work_[g];
-        if (w.converged || !w.failure.empty()) continue;
+      on_open_grains(it, [&](std::size_t g, GrainWork& w) {
         const points::Grain& gr = grains_[g];
         with_shape(settings_.shape, [&](auto tag) {
           evaluate<decltype(tag)>(w, trial_, settings_, points_, gr, *laws_[gr.material], dt);
         });
         if (w.failure.empty()) w.iterations = it;
-        const auto u = static_cast<double>(grains_[g].size());
-        phase_work(g, it) += u;
-        units += u;
-      }
-      comm_->count_work(units);
+        return static_cast<double>(gr.size());
+      });
     }
     const bool failed_here = local_failure();
     // Convergence of each evaluated grain: |R| <= tol * reference and |dv|_M <= tol * velocity
@@ -240,21 +248,12 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     if (it == settings_.max_iterations) break;
     {
       ScopedStage t(&timers_, "newton.solve");
-      double units = 0;
-      const ThreadedRegion threaded(&timers_, no > 1);
-#pragma omp parallel for schedule(dynamic, 1) if (no > 1) reduction(+ : units)
-      for (std::size_t i = 0; i < no; ++i) {
-        const std::size_t g = owned_[i];
-        GrainWork& w = *work_[g];
-        if (w.converged || !w.failure.empty()) continue;
+      on_open_grains(it, [&](std::size_t g, GrainWork& w) {
         const points::Grain& gr = grains_[g];
         newton_solve(w, trial_, settings_, points_, gr, *laws_[gr.material], w.compliance(), dt,
                      reuse_factor(w, settings_));
-        const double u = parallel::cost::kCgWork * w.cg_work;
-        phase_work(g, it) += u;
-        units += u;
-      }
-      comm_->count_work(units);
+        return parallel::cost::kCgWork * w.cg_work;
+      });
     }
     if (collect_failure()) return stats;
     if (have_contacts_) {
