@@ -253,6 +253,19 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
 }
 
 template <int Dim>
+void ImplicitSolver<Dim>::apply_lumped_impulse(std::int32_t g, std::int32_t a, const Vec<Dim>& P,
+                                               std::vector<double>& dv2) {
+  GrainWork& w = *work_[g];
+  if (P == w.P[a]) return;
+  const Vec<Dim> v_free = w.v[a] - w.P[a] / w.m[a];
+  w.P[a] = P;
+  const Vec<Dim> v_new = v_free + P / w.m[a];
+  double& acc = dv2[static_cast<std::size_t>(g)];
+  acc = std::max(acc, 0.0) + w.m[a] * (v_new - w.v[a]).squaredNorm();
+  w.v[a] = v_new;
+}
+
+template <int Dim>
 double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   if (distributed()) return update_contacts_distributed(stats);  // lumped, Gauss-Seidel
   // Response of each grain: its compliance group (exact, linearised) or the lumped 1/m_I.
@@ -351,15 +364,9 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   // (v += Z dP, or the lumped v = v_free + P/m), and a grain whose impulses changed iterates again.
   std::vector<double> dv2(work_.size(), -1.0);
   for (std::size_t s = 0; s < slot_ref_.size(); ++s) {
-    GrainWork& w = *work_[slot_ref_[s].first];
-    const std::int32_t a = slot_ref_[s].second;
-    if (slot_p[s] == slot_P_[s] || problem_.slots[s].group >= 0) continue;
+    if (problem_.slots[s].group >= 0) continue;
     slot_P_[s] = slot_p[s];
-    w.P[a] = slot_p[s];
-    const Vec<Dim> v_new = problem_.slots[s].v_free + slot_p[s] / w.m[a];
-    double& acc = dv2[slot_ref_[s].first];
-    acc = std::max(acc, 0.0) + w.m[a] * (v_new - w.v[a]).squaredNorm();
-    w.v[a] = v_new;
+    apply_lumped_impulse(slot_ref_[s].first, slot_ref_[s].second, slot_p[s], dv2);
   }
   // Each group's response on the threads: a group is one grain's, and writes only that grain's
   // velocities and its own slots' impulses.
@@ -416,15 +423,17 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
 }
 
 // The members defined here (the class is instantiated in solver.cpp).
-#define MPMCD_INSTANTIATE(D)                                                         \
-  template void ImplicitSolver<D>::set_warm_start(std::vector<WarmImpulse<D>>);      \
-  template void ImplicitSolver<D>::sort_unique(std::vector<WarmImpulse<D>>&);        \
-  template std::vector<WarmImpulse<D>> ImplicitSolver<D>::gather_warm_start() const; \
-  template Vec<D> ImplicitSolver<D>::slot_velocity(std::size_t) const;               \
-  template void ImplicitSolver<D>::spread_slot_impulses();                           \
-  template bool ImplicitSolver<D>::grain_compliance(std::size_t);                    \
-  template void ImplicitSolver<D>::build_slot_bases();                               \
-  template double ImplicitSolver<D>::update_contacts(StepStats&);
+#define MPMCD_INSTANTIATE(D)                                                                       \
+  template void ImplicitSolver<D>::set_warm_start(std::vector<WarmImpulse<D>>);                    \
+  template void ImplicitSolver<D>::sort_unique(std::vector<WarmImpulse<D>>&);                      \
+  template std::vector<WarmImpulse<D>> ImplicitSolver<D>::gather_warm_start() const;               \
+  template Vec<D> ImplicitSolver<D>::slot_velocity(std::size_t) const;                             \
+  template void ImplicitSolver<D>::spread_slot_impulses();                                         \
+  template bool ImplicitSolver<D>::grain_compliance(std::size_t);                                  \
+  template void ImplicitSolver<D>::build_slot_bases();                                             \
+  template double ImplicitSolver<D>::update_contacts(StepStats&);                                  \
+  template void ImplicitSolver<D>::apply_lumped_impulse(std::int32_t, std::int32_t, const Vec<D>&, \
+                                                        std::vector<double>&);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)
 #undef MPMCD_INSTANTIATE

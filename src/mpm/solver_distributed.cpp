@@ -394,14 +394,7 @@ double ImplicitSolver<Dim>::update_contacts_distributed(StepStats& stats) {
   // 4. New impulses into the grains: own slots here, ghost slots sent back to their owners.
   std::vector<double> dv2(work_.size(), -1.0);
   const auto apply = [&](std::int32_t g, std::int32_t a, const Vec<Dim>& P) {
-    GrainWork& w = *work_[g];
-    if (P == w.P[a]) return;
-    const Vec<Dim> v_free = w.v[a] - w.P[a] / w.m[a];
-    w.P[a] = P;
-    const Vec<Dim> v_new = v_free + P / w.m[a];
-    double& acc = dv2[g];
-    acc = std::max(acc, 0.0) + w.m[a] * (v_new - w.v[a]).squaredNorm();
-    w.v[a] = v_new;
+    apply_lumped_impulse(g, a, P, dv2);
   };
   for (std::size_t s = 0; s < slot_ref_.size(); ++s)
     if (role_[slot_ref_[s].first] == 1) apply(slot_ref_[s].first, slot_ref_[s].second, slot_p[s]);

@@ -155,6 +155,11 @@ class ImplicitSolver {
                              const std::vector<double>& weights);
   // Velocity of slot s from its grain's current nodal iterate: sum_k w_k v_{a_k} [m/s].
   Vec<Dim> slot_velocity(std::size_t s) const;
+  // The lumped response of grain g's node a to its new contact impulse P [N s], on one rank or
+  // several: v_a = v_free + P / m_a with v_free = v_a - P_a / m_a (method.md §4), P_a = P; adds
+  // m_a |dv|^2 to dv2[g] (which starts at -1: no change) [kg m^2/s^2]. Nothing when P = P_a.
+  void apply_lumped_impulse(std::int32_t g, std::int32_t a, const Vec<Dim>& P,
+                            std::vector<double>& dv2);
   // Nodal impulses of every grain from the slots' impulses slot_P_: P_a = sum_s w_sa P_s.
   void spread_slot_impulses();
   // Agrees on the lowest failing grain over the ranks (reduced here when `lowest` < 0, else that
