@@ -6,6 +6,10 @@
 # by stage names.
 # Usage: tools/same_outputs.sh OLD_BINARY NEW_BINARY [WORKDIR]; exit 0 when all are identical.
 set -u
+if [ $# -lt 2 ] || [ ! -x "$1" ] || [ ! -x "$2" ]; then
+  echo "usage: tools/same_outputs.sh OLD_BINARY NEW_BINARY [WORKDIR] (two executable mpmcd binaries)" >&2
+  exit 2
+fi
 command -v h5dump >/dev/null || { echo "same_outputs.sh: h5dump not found (apt-get install hdf5-tools)" >&2; exit 2; }
 old=$1; new=$2; work=${3:-/tmp/mpmcd_same_outputs}
 root=$(cd "$(dirname "$0")/.." && pwd)
