@@ -204,6 +204,10 @@ template <int Dim>
 void Run<Dim>::commit(const mpm::StepStats& st, double dt) {
   solver_->commit();
   last_ = st;
+  if (st.shrunk_domains > 0) {
+    ++summary_.shrunk_steps;
+    summary_.shrunk_domains_max = std::max(summary_.shrunk_domains_max, st.shrunk_domains);
+  }
   ledger_.add_step(st, solver_->settings().contact.walls, dt);  // the walls of this step
   if (comm_.size() > 1 && scheme_ == parallel::Scheme::kPartition && opt_.rebalance > 0 &&
       (summary_.steps + 1) % 50 == 0)  // docs/parallel.md: deterministic work weights
@@ -376,6 +380,11 @@ RunSummary Run<Dim>::finish() {
     log().info("{} rank(s), scheme {}: timers in {}_timers.csv", comm_.size(),
                parallel::to_string(scheme_), cfg_.simulation.name);
   }
+  if (summary_.shrunk_steps > 0)
+    log().warn(
+        "CPDI domains were shrunk to their window in {} of the {} steps of this run, at most {} "
+        "points in one step (docs/accuracy.md; more points per cell avoid it)",
+        summary_.shrunk_steps, summary_.steps - steps0_, summary_.shrunk_domains_max);
   if (summary_.interrupted) {
     log().warn("stopped ({}) at step {} (t = {:.9g} s)",
                summary_.signal != 0 ? signal_name(summary_.signal) : "--stop-after", summary_.steps,

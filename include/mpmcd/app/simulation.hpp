@@ -39,6 +39,11 @@ struct RunSummary {
   std::string checkpoint;              ///< last checkpoint written ("" if none)
   bool interrupted = false;            ///< stopped before end_time by a signal or stop_after
   int signal = 0;                      ///< signal that interrupted the run (0: none)
+  /// Committed steps of this invocation in which some CPDI domains spanned more than two cells
+  /// and were shrunk to their window for the shape functions (docs/accuracy.md) [-].
+  std::int64_t shrunk_steps = 0;
+  /// The most such points in one of those steps, over all grains and ranks [-].
+  std::int64_t shrunk_domains_max = 0;
 };
 
 /// Runs the whole simulation, from t = 0 or from `restart` (options.restart names its file);
