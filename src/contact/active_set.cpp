@@ -15,8 +15,6 @@ namespace mpmcd::contact {
 namespace {
 // Proximal steps of one solve before it is left to Gauss-Seidel.
 constexpr int kMaxProximalSteps = 30;
-// Block pivots of one proximal step before the shift grows (cycling on an ill-conditioned W_AA).
-constexpr int kMaxPivots = 100;
 // Gauss-Seidel sweeps before the pivoting: one, which finishes the problems whose warm start is
 // right (the later Newton iterations of a step) without the pivoting. More sweeps give the
 // pivoting a better first active set but cost more than the pivots they save where W and the
@@ -338,6 +336,65 @@ std::pair<double, double> violation(const NormalSystem& sys, const Eigen::Vector
   return {worst, scale};
 }
 
+// Primal active-set method for the shifted problem (Lawson & Hanson 1974, ch. 23, on the
+// strictly convex quadratic program min 1/2 x.(W + delta I) x + q.x, x >= 0, whose optimality
+// conditions are the complementarity problem of one proximal step): from a feasible x, solve on
+// the free set F; if a free impulse would turn negative, move toward the solution until the first
+// one reaches 0 and fix it; else free the contact whose velocity w_c / W_cc is the most negative.
+// The objective falls at every step, so it does not cycle where the block pivoting does (nearly
+// redundant face contacts of split points, docs/contact.md). Counts its solves in `pivots`; false
+// after `max_steps` solves, on a failed solve or when the contact just freed is fixed again at
+// once (round-off).
+bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>& W,
+                       const Eigen::VectorXd& q, const Eigen::VectorXd& d, double delta,
+                       Eigen::VectorXd& x, int max_steps, int& pivots) {
+  const Eigen::Index m = q.size();
+  std::vector<char> free(static_cast<std::size_t>(m));
+  for (Eigen::Index c = 0; c < m; ++c) free[c] = x[c] > 0.0;
+  Eigen::VectorXd z(m), w(m);
+  std::vector<std::int32_t> idx;
+  std::int32_t freed = -1;
+  for (int k = 0; k < max_steps; ++k) {
+    idx.clear();
+    for (Eigen::Index c = 0; c < m; ++c)
+      if (free[c]) idx.push_back(static_cast<std::int32_t>(c));
+    ++pivots;
+    if (!solver.solve(idx, q, z)) return false;
+    double alpha = 1.0;
+    std::int32_t hit = -1;
+    for (const std::int32_t c : idx)
+      if (z[c] < 0.0 && x[c] / (x[c] - z[c]) < alpha) {
+        alpha = x[c] / (x[c] - z[c]);
+        hit = c;
+      }
+    if (hit >= 0) {
+      if (hit == freed && alpha == 0.0) return false;
+      x += alpha * (z - x);
+      for (const std::int32_t c : idx)
+        if (c == hit || x[c] <= 0.0) {
+          x[c] = 0.0;
+          free[c] = 0;
+        }
+      freed = -1;
+      continue;
+    }
+    x = z;
+    w = q + W * x + delta * x;
+    double scale = x.cwiseAbs().maxCoeff();
+    for (Eigen::Index c = 0; c < m; ++c) scale = std::max(scale, std::abs(q[c]) / d[c]);
+    double most = -1e-12 * scale;  // the block pivoting's feasibility tolerance
+    freed = -1;
+    for (Eigen::Index c = 0; c < m; ++c)
+      if (!free[c] && w[c] / (d[c] + delta) < most) {
+        most = w[c] / (d[c] + delta);
+        freed = static_cast<std::int32_t>(c);
+      }
+    if (freed < 0) return true;
+    free[freed] = 1;
+  }
+  return false;
+}
+
 // Gauss-Seidel's error of frictionless contacts with impulses p: the relative distance
 // |loc - p| / |p| to their local solutions loc_c = max(0, p_c - w_c / W_cc), w = b + W p (the
 // local problem of contact c with the others' impulses fixed, method.md §4).
@@ -422,7 +479,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       std::size_t best = std::numeric_limits<std::size_t>::max();
       int tries = 3;
       bool pivoted = false;
-      for (int k = 0; k < kMaxPivots; ++k) {
+      for (int k = 0; k < settings.block_pivots; ++k) {
         idx.clear();
         for (Eigen::Index c = 0; c < m; ++c)
           if (active[c]) idx.push_back(static_cast<std::int32_t>(c));
@@ -449,6 +506,11 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
           infeasible.erase(infeasible.begin(), infeasible.end() - 1);
         }
         for (const std::int32_t c : infeasible) active[c] = !active[c];
+      }
+      if (!pivoted) {  // cycling: the primal method from the last proximal iterate (feasible)
+        next = p;
+        pivoted = primal_active_set(solver, W, q, d, delta, next, 3 * static_cast<int>(m) + 100,
+                                    result.pivots);
       }
       if (!pivoted) {
         if (delta >= 1e-6 * w_max) break;

@@ -259,3 +259,24 @@ TEST(ActiveSet, BorderedSolveMatchesAFreshFactorisation) {
   EXPECT_LT(complementarity_violation(next), 1e-10);
   expect_same_net_impulses(next, scratch, 1e-9);
 }
+
+TEST(ActiveSet, ThePrimalMethodAloneSolvesTheSameProblems) {
+  // GsSettings::block_pivots = 0: the primal active-set method (the fallback when the block
+  // pivoting cycles) solves from the warm start without any block pivot: the same impulses as
+  // Gauss-Seidel where W is positive definite, the same slot impulses where contacts are doubled.
+  contact::GsSettings s = tight();
+  s.block_pivots = 0;
+  for (int redundant : {0, 3}) {
+    for (unsigned seed : {1u, 2u, 7u}) {
+      const auto p = two_grain_problem(20, redundant, seed);
+      auto primal = p, sweeps = p;
+      const auto rp = contact::solve_active_set(primal, s);
+      const auto rg = contact::solve_gauss_seidel(sweeps, tight());
+      ASSERT_TRUE(rp.converged) << "seed " << seed << " redundant " << redundant;
+      EXPECT_EQ(rp.sweeps, 1);  // the first sweep only: the primal method met the tolerance
+      EXPECT_GE(rp.pivots, 1);
+      EXPECT_LT(complementarity_violation(primal), 1e-10);
+      if (rg.converged) expect_same_net_impulses(primal, sweeps, 1e-7);
+    }
+  }
+}
