@@ -56,6 +56,7 @@ class Run {
   void distribute();
   void commit(const mpm::StepStats& st, double dt);
   void rebalance();
+  void split_points();
   std::optional<std::string> stop_criterion(const mpm::StepStats& st);
   double grain_area();
   std::optional<std::string> loading_step(const mpm::StepStats& st, double dt);

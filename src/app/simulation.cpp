@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -25,6 +26,7 @@
 #include "mpmcd/core/log.hpp"
 #include "mpmcd/io/vtu.hpp"
 #include "mpmcd/parallel/distribute.hpp"
+#include "mpmcd/points/split.hpp"
 #include "mpmcd/version.hpp"
 #include "run.hpp"
 
@@ -203,6 +205,7 @@ void Run<Dim>::distribute() {
 template <int Dim>
 void Run<Dim>::commit(const mpm::StepStats& st, double dt) {
   solver_->commit();
+  if (st.oversized_domains > 0) split_points();
   last_ = st;
   if (st.shrunk_domains > 0) {
     ++summary_.shrunk_steps;
@@ -217,6 +220,40 @@ void Run<Dim>::commit(const mpm::StepStats& st, double dt) {
   summary_.newton_iterations += st.iterations;
   if (dt_control_.succeeded(st.iterations, dt) && !dt_control_.adaptive())
     log().info("dt restored to {:.4g} s at t = {:.9g} s", dt_control_.dt(), t_);
+}
+
+// Splits the points whose CPDI domain outgrew its window ([grid] split_points), after a step
+// that found some (StepStats::oversized_domains, the same count on every rank): the owners list
+// them, every rank applies the same list to its copy of the points (collective on several
+// ranks), and the warm-start keys follow the new point numbers. Children of a stretched split
+// can still be too wide: up to 8 rounds.
+template <int Dim>
+void Run<Dim>::split_points() {
+  if (settings_.shape != grid::ShapeKind::kCpdi || !cfg_.grid.split_points) return;
+  std::vector<std::size_t> mine;
+  for (std::size_t g = 0; g < model_.grains.size(); ++g)
+    if (solver_->owner()[g] == comm_.rank()) mine.push_back(g);
+  for (int round = 0; round < 8; ++round) {
+    auto splits = points::find_splits(model_.points, model_.grains, mine, model_.grid.cell_size());
+    if (comm_.size() > 1) {
+      std::vector<char> bytes(splits.size() * sizeof(points::Split));
+      std::memcpy(bytes.data(), splits.data(), bytes.size());
+      splits.clear();
+      for (const auto& b : comm_.allgather(bytes)) {
+        const std::size_t k = splits.size();
+        splits.resize(k + b.size() / sizeof(points::Split));
+        std::memcpy(splits.data() + k, b.data(), b.size());
+      }
+      std::sort(splits.begin(), splits.end(),
+                [](const points::Split& a, const points::Split& b) { return a.point < b.point; });
+    }
+    if (splits.empty()) return;
+    solver_->renumber_points(points::apply_splits(model_.points, model_.grains, splits));
+    if (root_ && summary_.split_points == 0)
+      log().info("t = {:.9g} s: first {} point(s) split in two (CPDI domains wider than a cell)",
+                 t_, splits.size());
+    summary_.split_points += static_cast<std::int64_t>(splits.size());
+  }
 }
 
 // Deals the grains again when the work imbalance exceeds --rebalance (collective).
@@ -380,6 +417,9 @@ RunSummary Run<Dim>::finish() {
     log().info("{} rank(s), scheme {}: timers in {}_timers.csv", comm_.size(),
                parallel::to_string(scheme_), cfg_.simulation.name);
   }
+  if (summary_.split_points > 0 && root_)
+    log().info("{} point(s) were split in two during this run ([grid] split_points), {} now",
+               summary_.split_points, model_.points.size());
   if (summary_.shrunk_steps > 0)
     log().warn(
         "CPDI domains were shrunk to their window in {} of the {} steps of this run, at most {} "

@@ -111,6 +111,13 @@ Schema build_schema() {
            .greater_than(0.0),
        KeySpec::string("shape_function", &GridSection::shape_function, "MPM shape functions")
            .one_of({"linear", "ugimp", "cpdi"})
+           .default_of_member(),
+       KeySpec::boolean("split_points", &GridSection::split_points,
+                        "with `cpdi`: after each step, a point whose domain F D0 spans more than "
+                        "one cell along an axis is split in two along its most stretched edge, "
+                        "so that every domain fits its 3-node window and the domains keep tiling "
+                        "the grain (docs/accuracy.md, \"Point splitting\"); false shrinks such a "
+                        "domain to the window instead. No effect with other shape functions")
            .default_of_member()});
 
   s.add_table(

@@ -21,6 +21,17 @@ void ImplicitSolver<Dim>::set_warm_start(std::vector<WarmImpulse<Dim>> impulses)
 }
 
 template <int Dim>
+void ImplicitSolver<Dim>::renumber_points(std::span<const std::int64_t> index) {
+  constexpr std::int64_t faces = 2 * Dim;  // face number = point * 2 Dim + 2 axis + side
+  for (auto& w : previous_)
+    if (w.node < 0 && w.a >= 0) {
+      const std::int64_t f = -1 - w.node;
+      w.node = -1 - (index[static_cast<std::size_t>(f / faces)] * faces + f % faces);
+    }
+  sort_unique(previous_);
+}
+
+template <int Dim>
 void ImplicitSolver<Dim>::sort_unique(std::vector<WarmImpulse<Dim>>& impulses) {
   const auto key = [](const WarmImpulse<Dim>& x) { return std::tie(x.node, x.a, x.b); };
   std::stable_sort(
@@ -425,6 +436,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
 // The members defined here (the class is instantiated in solver.cpp).
 #define MPMCD_INSTANTIATE(D)                                                                       \
   template void ImplicitSolver<D>::set_warm_start(std::vector<WarmImpulse<D>>);                    \
+  template void ImplicitSolver<D>::renumber_points(std::span<const std::int64_t>);                 \
   template void ImplicitSolver<D>::sort_unique(std::vector<WarmImpulse<D>>&);                      \
   template std::vector<WarmImpulse<D>> ImplicitSolver<D>::gather_warm_start() const;               \
   template Vec<D> ImplicitSolver<D>::slot_velocity(std::size_t) const;                             \

@@ -329,6 +329,11 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     ledger[4 * g + 3] = dt * work_ext;
   }
   over_ranks(ledger, &parallel::Comm::sum);  // one rank owns each grain: the sum is exact
+  if (settings_.shape == grid::ShapeKind::kCpdi)
+    for (std::size_t g : owned_)
+      for (std::int64_t p = grains_[g].begin; p < grains_[g].end; ++p)
+        if (!grid::fits_cpdi_window<Dim>(trial_.F[p] * points_.domain[p], grid_.cell_size()))
+          ++stats.oversized_domains;
   for (std::size_t g = 0; g < grains_.size(); ++g) {
     stats.contact_work += ledger[4 * g];
     stats.transfer_loss += ledger[4 * g + 1];
@@ -354,8 +359,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   }
   {  // sums over the ranks' contacts, added in rank order
     std::vector<std::int64_t> n{
-        stats.contacts,       stats.active_contacts,          stats.linear_solves,
-        stats.factorizations, stats.projected_factorizations, stats.shrunk_domains};
+        stats.contacts,         stats.active_contacts,          stats.linear_solves,
+        stats.factorizations,   stats.projected_factorizations, stats.shrunk_domains,
+        stats.oversized_domains};
     over_ranks(n, &parallel::Comm::sum);
     std::vector<std::int64_t> it{-stats.iterations};
     over_ranks(it, &parallel::Comm::min);
@@ -365,6 +371,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.factorizations = n[3];
     stats.projected_factorizations = n[4];
     stats.shrunk_domains = n[5];
+    stats.oversized_domains = n[6];
     stats.iterations = static_cast<int>(-it[0]);
     over_ranks(wall_f, &parallel::Comm::sum);  // one rank holds each grain's wall contacts: exact
   }

@@ -44,6 +44,9 @@ struct RunSummary {
   std::int64_t shrunk_steps = 0;
   /// The most such points in one of those steps, over all grains and ranks [-].
   std::int64_t shrunk_domains_max = 0;
+  /// Points split in two in this invocation because their CPDI domain outgrew its window
+  /// ([grid] split_points; docs/accuracy.md, "Point splitting") [-].
+  std::int64_t split_points = 0;
 };
 
 /// Runs the whole simulation, from t = 0 or from `restart` (options.restart names its file);

@@ -123,6 +123,18 @@ struct Cpdi1D {
   static constexpr int kNodes = 3;  ///< nodes per axis in the support window
 };
 
+/// Largest half-extent along an axis [m] of a domain whose corners fit the CPDI1 window of a grid
+/// of cell size `h` [m]: a bounding box at most one cell wide spans at most two cells.
+inline double cpdi_window_half_extent(double h) {
+  return 0.5 * h * (1.0 - 1e-9);
+}
+
+/// True when the domain D [m] (columns: half-edges) fits the CPDI1 window on cells of size h [m].
+template <int Dim>
+bool fits_cpdi_window(const Mat<Dim>& D, double h) {
+  return D.cwiseAbs().rowwise().sum().maxCoeff() <= cpdi_window_half_extent(h);
+}
+
 /// The domain D [m] (columns: half-edges) scaled down about the point until its bounding box is
 /// at most one cell h [m] wide along every axis, so that its corners span at most two cells (the
 /// CPDI1 window); D itself when it already fits. The scaled domain still gives a partition of
@@ -130,7 +142,7 @@ struct Cpdi1D {
 template <int Dim>
 Mat<Dim> fit_cpdi_window(const Mat<Dim>& D, double h) {
   const double half = D.cwiseAbs().rowwise().sum().maxCoeff();  // largest half-extent [m]
-  const double limit = 0.5 * h * (1.0 - 1e-9);
+  const double limit = cpdi_window_half_extent(h);
   return half <= limit ? D : Mat<Dim>(D * (limit / half));
 }
 

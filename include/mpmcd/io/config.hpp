@@ -27,6 +27,7 @@ struct GridSection {
   std::vector<double> extent;             ///< size of the grid along each axis [m], Dim entries
   double cell_size = 0.0;                 ///< cell edge length h [m]
   std::string shape_function = "linear";  ///< "linear", "ugimp" or "cpdi"
+  bool split_points = true;  ///< split points whose CPDI domain outgrows its window [-]
 };
 
 /// [[materials]]: a named material, its constitutive law and the law's parameters.

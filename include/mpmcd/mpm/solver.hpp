@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <source_location>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct StepStats {
   /// Points whose CPDI domain spans more than two cells along an axis and whose shape functions
   /// used it shrunk to fit the window (grid::fit_cpdi_window), summed over grains [-].
   std::int64_t shrunk_domains = 0;
+  /// Points whose CPDI domain F^{n+1} D0 at the end of the step does not fit the window
+  /// (grid::fits_cpdi_window), summed over grains and ranks: the points to split (CPDI only) [-].
+  std::int64_t oversized_domains = 0;
   /// Work of the contact impulses on the grains over the step, sum_I P_I . (v_I^n + v_I^{n+1}) / 2
   /// over every grain node (the exact kinetic-energy change they cause on the grid) [J] (2D: J/m).
   double contact_work = 0;
@@ -113,6 +117,9 @@ class ImplicitSolver {
   const std::vector<WarmImpulse<Dim>>& warm_start() const { return previous_; }
   /// Replaces the warm-start impulses (a restart); sorts them by (node, a, b).
   void set_warm_start(std::vector<WarmImpulse<Dim>> impulses);
+  /// Follows a renumbering of the points (points::apply_splits): `index[p]` is old point p's new
+  /// index; renames the points in the warm-start keys of grain-face contacts.
+  void renumber_points(std::span<const std::int64_t> index);
   /// Every rank's warm-start impulses, sorted by (node, a, b), one per contact (collective on
   /// several ranks; this rank's own when serial): checkpoints and re-distribution.
   std::vector<WarmImpulse<Dim>> gather_warm_start() const;

@@ -49,6 +49,16 @@ struct PointSet {
     f(set.sigma_zz);
     f(set.volume);
   }
+  /// Calls f on every per-point array (one entry per point; `history`, per grain blocks, is not
+  /// one): the state fields of for_each_state_field, then mass, volume0, domain, grain.
+  template <class Set, class Fn>
+  static void for_each_point_field(Set& set, Fn&& f) {
+    for_each_state_field(set, f);
+    f(set.mass);
+    f(set.volume0);
+    f(set.domain);
+    f(set.grain);
+  }
   /// Appends a point with F = I and zero stress; `dom` holds its reference domain's half-edge
   /// vectors as columns [m].
   void add(const Vec<Dim>& pos, const Vec<Dim>& vel, double m, double vol, const Mat<Dim>& dom,
