@@ -72,11 +72,14 @@ struct DiskRun {
 };
 
 // Runs the disk at R/h = `rh` with step `dt` [s] and wall speed `speed` [m/s] to Delta/D = 0.4,
-// the walls acting on the grid nodes (`wall_contact` "nodes") or on the points' faces ("points").
+// the walls acting on the grid nodes (`wall_contact` "nodes") or on the points' faces ("points"),
+// seeded with `points_per_cell`, contacts solved by `contact_solver` ([contact] solver).
 inline DiskRun run_disk(int rh, double lambda, double dt, double speed,
-                        const std::string& wall_contact = "nodes") {
+                        const std::string& wall_contact = "nodes", int points_per_cell = 2,
+                        const std::string& contact_solver = "gauss_seidel") {
   const double h = kRadius / rh, t_end = 0.4 * kRadius / speed;
-  const std::string tag = fmt::format("{}_{:g}_{:g}_{:g}_{}", rh, lambda, dt, speed, wall_contact);
+  const std::string tag = fmt::format("{}_{:g}_{:g}_{:g}_{}_{}_{}", rh, lambda, dt, speed,
+                                      wall_contact, points_per_cell, contact_solver);
   const fs::path dir = mpmcd::test_support::scratch_dir("squeeze_fe", tag);
   std::ofstream(dir / "disk.toml") << fmt::format(
       "[simulation]\nname = \"disk\"\n"
@@ -85,17 +88,17 @@ inline DiskRun run_disk(int rh, double lambda, double dt, double speed,
       "[[materials]]\nname = \"gel\"\nlaw = \"neo_hookean\"\ndensity = {}\nlambda = {:.17g}\n"
       "mu = {}\n"
       "[[grains]]\nshape = \"disk\"\nmaterial = \"gel\"\ncenter = [0.0, 0.0]\nradius = {}\n"
-      "points_per_cell = 2\n"
+      "points_per_cell = {}\n"
       "[time]\ndt = {:.17g}\nend_time = {:.17g}\n"
       "[solver]\naffine = true\n"
-      "[contact]\nfriction = 0.0\nwall_contact = \"{}\"\n"
+      "[contact]\nfriction = 0.0\nwall_contact = \"{}\"\nsolver = \"{}\"\n"
       "[[walls]]\nname = \"bottom\"\npoint = [0.0, {}]\nnormal = [0.0, 1.0]\n"
       "velocity = [0.0, {:.17g}]\n"
       "[[walls]]\nname = \"top\"\npoint = [0.0, {}]\nnormal = [0.0, -1.0]\n"
       "velocity = [0.0, {:.17g}]\n"
       "[output]\ncsv_interval = {:.17g}\nvtu = false\n",
-      h, kRho, lambda, kMu, kRadius, dt, t_end, wall_contact, -kRadius, speed, kRadius, -speed,
-      t_end / 400);
+      h, kRho, lambda, kMu, kRadius, points_per_cell, dt, t_end, wall_contact, contact_solver,
+      -kRadius, speed, kRadius, -speed, t_end / 400);
   const auto r = mpmcd::test_support::run("run -q -t 1 " + (dir / "disk.toml").string() + " -o " +
                                           (dir / "out").string());
   EXPECT_EQ(r.code, 0) << r.output;
