@@ -11,10 +11,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -22,6 +25,7 @@
 #include "cli_runner.hpp"
 #include "mpmcd/analysis/time_series.hpp"
 #include "scratch.hpp"
+#include "vtu_reader.hpp"
 
 namespace mpmcd::test_support::squeeze {
 
@@ -31,15 +35,18 @@ inline constexpr double kRadius = 1e-3, kMu = 1.5e6, kRho = 990.0;
 inline const double kSpeed = 0.01 * std::sqrt(kMu / kRho);                       // each wall [m/s]
 inline const std::vector<double> kStations = {0.05, 0.1, 0.15, 0.2, 0.3, 0.39};  // Delta/D [-]
 
-// FE force P(Delta/D) [N/m] for `lambda` [Pa], from tests/reference/squeezed_disk.
+// FE force P(Delta/D) [N/m] and contact half-width a(Delta/D) [m] for `lambda` [Pa], from
+// tests/reference/squeezed_disk.
 struct FeCurve {
-  std::vector<double> x, force;
-  double at(double d) const {
+  std::vector<double> x, force, half_width;
+  // Linear interpolation of `y` (force or half_width) at Delta/D = d.
+  double interp(const std::vector<double>& y, double d) const {
     const auto it = std::lower_bound(x.begin(), x.end(), d);
     const auto i = static_cast<std::size_t>(
         std::clamp<std::ptrdiff_t>(it - x.begin(), 1, static_cast<std::ptrdiff_t>(x.size()) - 1));
-    return force[i - 1] + (force[i] - force[i - 1]) * (d - x[i - 1]) / (x[i] - x[i - 1]);
+    return y[i - 1] + (y[i] - y[i - 1]) * (d - x[i - 1]) / (x[i] - x[i - 1]);
   }
+  double at(double d) const { return interp(force, d); }
 };
 
 inline FeCurve fe_curve(double lambda) {
@@ -61,6 +68,7 @@ inline FeCurve fe_curve(double lambda) {
     if (v.size() >= 5 && v[0] == lambda) {
       c.x.push_back(v[3]);
       c.force.push_back(v[4]);
+      c.half_width.push_back(v[5]);
     }
   }
   return c;
@@ -69,6 +77,10 @@ inline FeCurve fe_curve(double lambda) {
 struct DiskRun {
   std::vector<double> ratio;  // MPM force / FE force at kStations [-]
   double stored = 0;          // elastic + kinetic change / work of both walls at the end [-]
+  // Per VTU output with contacts on the top wall: Delta/D, the MPM contact half-width (half the
+  // span of its active contacts, which sit on node columns, plus half a cell) and the FE
+  // half-width [m].
+  std::vector<std::array<double, 3>> half_width;
 };
 
 // Runs the disk at R/h = `rh` with step `dt` [s] and wall speed `speed` [m/s] to Delta/D = 0.4,
@@ -96,9 +108,9 @@ inline DiskRun run_disk(int rh, double lambda, double dt, double speed,
       "velocity = [0.0, {:.17g}]\n"
       "[[walls]]\nname = \"top\"\npoint = [0.0, {}]\nnormal = [0.0, -1.0]\n"
       "velocity = [0.0, {:.17g}]\n"
-      "[output]\ncsv_interval = {:.17g}\nvtu = false\n",
+      "[output]\ncsv_interval = {:.17g}\nvtu_interval = {:.17g}\n",
       h, kRho, lambda, kMu, kRadius, points_per_cell, dt, t_end, wall_contact, contact_solver,
-      -kRadius, speed, kRadius, -speed, t_end / 400);
+      -kRadius, speed, kRadius, -speed, t_end / 400, t_end / 8);
   const auto r = mpmcd::test_support::run("run -q -t 1 " + (dir / "disk.toml").string() + " -o " +
                                           (dir / "out").string());
   EXPECT_EQ(r.code, 0) << r.output;
@@ -117,6 +129,27 @@ inline DiskRun run_disk(int rh, double lambda, double dt, double speed,
     }
     out.ratio.push_back(p > 0 ? f / p : 0.0);
   }
+  // Contact half-width from the contacts VTU series (disk_contacts.pvd: one file per output).
+  std::ifstream pvd(dir / "out" / "disk_contacts.pvd");
+  const std::string series((std::istreambuf_iterator<char>(pvd)), std::istreambuf_iterator<char>());
+  const std::regex entry(R"(timestep=\"([^\"]+)\"[^>]*file=\"([^\"]+)\")");
+  for (auto it = std::sregex_iterator(series.begin(), series.end(), entry);
+       it != std::sregex_iterator(); ++it) {
+    const double d = 2 * speed * std::stod((*it)[1]) / (2 * kRadius);
+    const VtuData c = read_vtu((dir / "out" / std::string((*it)[2])).string());
+    double lo = 1e300, hi = -1e300;
+    const auto& p = c.arrays.at("normal_impulse");
+    const auto& a = c.arrays.at("body_a");
+    for (std::size_t k = 0; k < p.size(); ++k)
+      if (p[k] > 0 && a[k] < 0 && c.points[3 * k + 1] > 0) {  // the top wall's active contacts
+        lo = std::min(lo, c.points[3 * k]);
+        hi = std::max(hi, c.points[3 * k]);
+      }
+    // The contacts sit on node columns (spacing h): each stands for the column of width h about
+    // it, so the contact zone reaches half a cell beyond the outermost active one.
+    if (hi >= lo)
+      out.half_width.push_back({d, 0.5 * (hi - lo) + 0.5 * h, fe.interp(fe.half_width, d)});
+  }
   const double work = s.column("wall_top_work").back() + s.column("wall_bottom_work").back();
   out.stored = s.column("energy_change").back() / work;
   return out;
@@ -126,7 +159,18 @@ inline void print(const std::string& label, const DiskRun& r) {
   std::string line = "  " + label + ": force / FE";
   for (std::size_t k = 0; k < kStations.size(); ++k)
     line += fmt::format("  {:.2f}: {:.4f}", kStations[k], r.ratio[k]);
+  line += "; contact half-width (MPM - FE) / R at Delta/D";
+  for (const auto& [d, mpm, fe] : r.half_width)
+    line += fmt::format("  {:.3f}: {:+.4f}", d, (mpm - fe) / kRadius);
   std::printf("%s; stored / wall work %.4f\n", line.c_str(), r.stored);
+}
+
+// The largest |MPM - FE| contact half-width over the outputs at Delta/D >= 0.05 [m].
+inline double worst_half_width(const DiskRun& r) {
+  double e = 0;
+  for (const auto& [d, mpm, fe] : r.half_width)
+    if (d >= 0.05) e = std::max(e, std::abs(mpm - fe));
+  return e;
 }
 
 inline double worst(const DiskRun& r) {
