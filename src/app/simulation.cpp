@@ -244,8 +244,7 @@ void Run<Dim>::split_points() {
         splits.resize(k + b.size() / sizeof(points::Split));
         std::memcpy(splits.data() + k, b.data(), b.size());
       }
-      std::sort(splits.begin(), splits.end(),
-                [](const points::Split& a, const points::Split& b) { return a.point < b.point; });
+      points::sort_splits(splits);
     }
     if (splits.empty()) return;
     solver_->renumber_points(points::apply_splits(model_.points, model_.grains, splits));

@@ -354,6 +354,8 @@ bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>&
   Eigen::VectorXd z(m), w(m);
   std::vector<std::int32_t> idx;
   std::int32_t freed = -1;
+  double q_scale = 0;  // the largest |q_c| / W_cc [N s]
+  for (Eigen::Index c = 0; c < m; ++c) q_scale = std::max(q_scale, std::abs(q[c]) / d[c]);
   for (int k = 0; k < max_steps; ++k) {
     idx.clear();
     for (Eigen::Index c = 0; c < m; ++c)
@@ -380,8 +382,7 @@ bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>&
     }
     x = z;
     w = q + W * x + delta * x;
-    double scale = x.cwiseAbs().maxCoeff();
-    for (Eigen::Index c = 0; c < m; ++c) scale = std::max(scale, std::abs(q[c]) / d[c]);
+    const double scale = std::max(x.cwiseAbs().maxCoeff(), q_scale);
     double most = -1e-12 * scale;  // the block pivoting's feasibility tolerance
     freed = -1;
     for (Eigen::Index c = 0; c < m; ++c)

@@ -7,6 +7,11 @@
 
 namespace mpmcd::points {
 
+void sort_splits(std::vector<Split>& splits) {
+  std::sort(splits.begin(), splits.end(),
+            [](const Split& a, const Split& b) { return a.point < b.point; });
+}
+
 template <int Dim>
 std::vector<Split> find_splits(const PointSet<Dim>& points, const std::vector<Grain>& grains,
                                std::span<const std::size_t> which, double h) {
@@ -17,12 +22,11 @@ std::vector<Split> find_splits(const PointSet<Dim>& points, const std::vector<Gr
       if (grid::fits_cpdi_window<Dim>(D, h)) continue;
       // The widest axis r (largest row sum of |D|) and the edge that spans most of it.
       Eigen::Index r = 0, k = 0;
-      D.cwiseAbs().rowwise().sum().maxCoeff(&r);
+      grid::cpdi_half_extents<Dim>(D).maxCoeff(&r);
       D.row(r).cwiseAbs().maxCoeff(&k);
       out.push_back({p, static_cast<std::int32_t>(k)});
     }
-  std::sort(out.begin(), out.end(),
-            [](const Split& a, const Split& b) { return a.point < b.point; });
+  sort_splits(out);
   return out;
 }
 

@@ -129,10 +129,16 @@ inline double cpdi_window_half_extent(double h) {
   return 0.5 * h * (1.0 - 1e-9);
 }
 
+/// Half-extents of the domain D [m] (columns: half-edges) along each axis, the row sums of |D| [m].
+template <int Dim>
+Vec<Dim> cpdi_half_extents(const Mat<Dim>& D) {
+  return D.cwiseAbs().rowwise().sum();
+}
+
 /// True when the domain D [m] (columns: half-edges) fits the CPDI1 window on cells of size h [m].
 template <int Dim>
 bool fits_cpdi_window(const Mat<Dim>& D, double h) {
-  return D.cwiseAbs().rowwise().sum().maxCoeff() <= cpdi_window_half_extent(h);
+  return cpdi_half_extents<Dim>(D).maxCoeff() <= cpdi_window_half_extent(h);
 }
 
 /// The domain D [m] (columns: half-edges) scaled down about the point until its bounding box is
@@ -141,7 +147,7 @@ bool fits_cpdi_window(const Mat<Dim>& D, double h) {
 /// unity with exact linear fields, but no longer tiles the body with its neighbours.
 template <int Dim>
 Mat<Dim> fit_cpdi_window(const Mat<Dim>& D, double h) {
-  const double half = D.cwiseAbs().rowwise().sum().maxCoeff();  // largest half-extent [m]
+  const double half = cpdi_half_extents<Dim>(D).maxCoeff();  // largest half-extent [m]
   const double limit = cpdi_window_half_extent(h);
   return half <= limit ? D : Mat<Dim>(D * (limit / half));
 }

@@ -18,6 +18,9 @@ struct Split {
   std::int32_t edge = 0;   ///< column of the domain halved [-]
 };
 
+/// Sorts splits by point (the order apply_splits needs).
+void sort_splits(std::vector<Split>& splits);
+
 /// The points of the grains `which` whose current domain F D0 does not fit the CPDI1 window on
 /// cells of size h [m] (grid::fits_cpdi_window), each with the edge to halve: the column of F D0
 /// that contributes most to its widest axis. Ascending by point.
