@@ -475,12 +475,14 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       w = q + W * p + delta * p;
       for (Eigen::Index c = 0; c < m; ++c) active[c] = p[c] - w[c] / (d[c] + delta) > 0.0;
       // Block principal pivoting (Judice & Pires 1994): flip every infeasible contact while
-      // their number falls (three more tries when it does not), then one at a time, the last one
-      // (Murty 1974), which terminates for a positive-definite matrix.
+      // their number falls (three more tries when it does not). When it stops falling, the
+      // infeasible contacts left are a few nearly redundant ones that block flips trade back and
+      // forth (and Murty's one-at-a-time rule took tens of pivots for, docs/contact.md): the
+      // primal active-set method finishes from the last iterate, clipped to p >= 0.
       std::size_t best = std::numeric_limits<std::size_t>::max();
       int tries = 3;
-      bool pivoted = false;
-      for (int k = 0; k < settings.block_pivots; ++k) {
+      bool pivoted = false, stalled = false;
+      for (int k = 0; k < settings.block_pivots && !stalled; ++k) {
         idx.clear();
         for (Eigen::Index c = 0; c < m; ++c)
           if (active[c]) idx.push_back(static_cast<std::int32_t>(c));
@@ -504,12 +506,13 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
         } else if (tries > 0) {
           --tries;
         } else {
-          infeasible.erase(infeasible.begin(), infeasible.end() - 1);
+          stalled = true;
+          break;
         }
         for (const std::int32_t c : infeasible) active[c] = !active[c];
       }
-      if (!pivoted) {  // cycling: the primal method from the last proximal iterate (feasible)
-        next = p;
+      if (!pivoted) {  // stalled or cycling: the primal method from a feasible point
+        next = stalled ? next.cwiseMax(0.0) : p;
         pivoted = primal_active_set(solver, W, q, d, delta, next, 3 * static_cast<int>(m) + 100,
                                     result.pivots);
       }

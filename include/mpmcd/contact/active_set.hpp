@@ -5,7 +5,7 @@
 /// with b_c = n_c . (v_free,B - v_free,A) + g_c / dt the relative normal velocity without impulses
 /// and W_cd = n_c . (response of contact c's relative velocity to a unit impulse n_d on contact d)
 /// the normal Delassus matrix (method.md §4 without friction), solved by block principal pivoting
-/// (Judice & Pires 1994, with Murty's single-pivot rule as the finite fallback) with a sparse
+/// (Judice & Pires 1994; the primal active-set method finishes when it stalls) with a sparse
 /// LDL^T of W on the active set. Unlike Gauss-Seidel its cost does not grow with the
 /// conditioning of W: nearly redundant contacts (two grains' faces on one interface) cost nothing
 /// more. Redundant ones (W_AA singular) are solved through proximal steps on W + delta I.

@@ -87,9 +87,9 @@ struct GsSettings {
   /// Gauss-Seidel), instead of one by one: near-redundant contacts at a node where a light field
   /// is pinched between two grains then cost one step, not thousands of sweeps.
   bool node_blocks = true;
-  /// solve_active_set: block principal pivots per proximal step before the primal active-set
-  /// method takes over from the last proximal iterate (the block pivoting may cycle on nearly
-  /// redundant contacts; docs/contact.md) [-].
+  /// solve_active_set: block principal pivots per proximal step at most before the primal
+  /// active-set method takes over from the last proximal iterate (it takes over earlier, from the
+  /// last pivot, when the number of infeasible contacts stops falling; docs/contact.md) [-].
   int block_pivots = 100;
   /// Where the threaded sweeps and error sums add their time (ThreadedRegion); none if null.
   StageTimers* timers = nullptr;
