@@ -482,7 +482,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       std::size_t best = std::numeric_limits<std::size_t>::max();
       int tries = 3;
       bool pivoted = false, stalled = false;
-      for (int k = 0; k < settings.block_pivots && !stalled; ++k) {
+      for (int k = 0; k < settings.block_pivots; ++k) {
         idx.clear();
         for (Eigen::Index c = 0; c < m; ++c)
           if (active[c]) idx.push_back(static_cast<std::int32_t>(c));
