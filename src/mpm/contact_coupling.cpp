@@ -98,43 +98,32 @@ void ImplicitSolver<Dim>::spread_slot_impulses() {
 
 namespace {
 
-// Y = L^-1 P Z in place of w.Z (LDL^T of the grain's Newton matrix, P A P^T = L D L^T): the
-// column-by-column sparse solve of Eigen (x_r -= x_i L_ri for each column x with x_i != 0, i in
-// order) done on all columns at once, row by row of a row-major copy, so that each L_ri updates a
-// contiguous run of Y's row r: the same operations on every nonzero, vectorised. Each row keeps
-// the range of columns where it may be nonzero (a column outside is exactly 0 there and skipped,
-// as Eigen skips it); inside, an entry with x_i = 0 is updated by 0 (a zero's sign aside, the
-// same value). 3x cheaper than the per-column solve on the CPDI grains of the paper compaction.
-template <class Work>
-void forward_substitute(Work& w) {
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  RowMajor Y = w.ldlt.permutationP() * w.Z;
-  const auto n = Y.rows();
-  const auto ncol = Y.cols();
-  std::vector<Eigen::Index> lo(static_cast<std::size_t>(n), ncol),
-      hi(static_cast<std::size_t>(n), 0);
-  for (Eigen::Index r = 0; r < n; ++r)
-    for (Eigen::Index c = 0; c < ncol; ++c)
-      if (Y(r, c) != 0.0) {
-        lo[static_cast<std::size_t>(r)] = std::min(lo[static_cast<std::size_t>(r)], c);
-        hi[static_cast<std::size_t>(r)] = c + 1;
-      }
-  const auto& L = w.ldlt.matrixL().nestedExpression();
-  for (Eigen::Index i = 0; i < n; ++i) {
+// Y = L^-1 Y in place (LDL^T of the grain's Newton matrix, P A P^T = L D L^T; Y, row-major
+// n x ncol, holds P E B on entry): the column-by-column sparse solve of Eigen (x_r -= x_i L_ri for
+// each column x with x_i != 0, i in order) done on all columns at once, row by row, so that each
+// L_ri updates a contiguous run of Y's row r: the same operations on every nonzero, vectorised.
+// Each row keeps the range [lo, hi) of columns where it may be nonzero (lo = hi: none; a column
+// outside is exactly 0 there and skipped, as Eigen skips it); inside, an entry with x_i = 0 is
+// updated by 0 (a zero's sign aside, the same value). 3x cheaper than the per-column solve on
+// the CPDI grains of the paper compaction.
+template <class Factor>
+void forward_substitute(const Factor& ldlt, double* Y, Eigen::Index ncol,
+                        std::vector<Eigen::Index>& lo, std::vector<Eigen::Index>& hi) {
+  const auto& L = ldlt.matrixL().nestedExpression();
+  for (Eigen::Index i = 0; i < L.outerSize(); ++i) {
     const Eigen::Index a = lo[static_cast<std::size_t>(i)], b = hi[static_cast<std::size_t>(i)];
     if (a >= b) continue;
-    const double* yi = Y.data() + i * ncol;
+    const double* yi = Y + i * ncol;
     for (typename std::decay_t<decltype(L)>::InnerIterator it(L, i); it; ++it) {
       const Eigen::Index r = it.index();
       if (r <= i) continue;  // the unit diagonal (and nothing above it) is not applied
       const double l = it.value();
-      double* yr = Y.data() + r * ncol;
+      double* yr = Y + r * ncol;
       for (Eigen::Index c = a; c < b; ++c) yr[c] -= yi[c] * l;
       lo[static_cast<std::size_t>(r)] = std::min(lo[static_cast<std::size_t>(r)], a);
       hi[static_cast<std::size_t>(r)] = std::max(hi[static_cast<std::size_t>(r)], b);
     }
   }
-  w.Z = Y;
 }
 
 }  // namespace
@@ -202,62 +191,104 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   // few nodes (the triangular solve skips zero entries). 4x cheaper than Z = A^-1 E for a CPDI
   // disk (docs/accuracy.md, cost); the velocity response then takes one back substitution.
   w.z_forward = !w.lumped_group && settings_.linear_solver == LinearSolverKind::kLdlt;
-  // Column (j, m) of E B, without the prescribed components (which do not respond).
-  w.Z.setZero(ndof, ncol);
-  for (Eigen::Index j = 0; j < k; ++j) {
-    const std::size_t s = static_cast<std::size_t>(w.slots[j]);
-    const Mat<Dim>& B = slot_basis_[s];
-    for (Eigen::Index m = 0; m < slot_rank_[s]; ++m)
-      for (std::int32_t q = slot_start_[s]; q < slot_start_[s + 1]; ++q) {
-        const std::int32_t a = slot_node_[q];
-        const double f = slot_weight_[q] / (w.lumped_group ? w.m[a] : 1.0);
-        for (int d = 0; d < Dim; ++d)
-          if (!(w.mask[a] & (1u << d)) && B(d, m) != 0.0)
-            w.Z(a * Dim + d, w.z_col[static_cast<std::size_t>(j)] + m) = f * B(d, m);
-      }
-  }
+  // Column (j, m) of E B, without the prescribed components (which do not respond): into Z, or
+  // for the forward-only response into row P_r of Y (kept from call to call, so that its memory
+  // is reused), with each row's range of nonzero columns.
+  const auto fill = [&](auto&& entry) {
+    for (Eigen::Index j = 0; j < k; ++j) {
+      const std::size_t s = static_cast<std::size_t>(w.slots[j]);
+      const Mat<Dim>& B = slot_basis_[s];
+      for (Eigen::Index m = 0; m < slot_rank_[s]; ++m)
+        for (std::int32_t q = slot_start_[s]; q < slot_start_[s + 1]; ++q) {
+          const std::int32_t a = slot_node_[q];
+          const double f = slot_weight_[q] / (w.lumped_group ? w.m[a] : 1.0);
+          for (int d = 0; d < Dim; ++d)
+            if (!(w.mask[a] & (1u << d)) && B(d, m) != 0.0)
+              entry(a * Dim + d, w.z_col[static_cast<std::size_t>(j)] + m, f * B(d, m));
+        }
+    }
+  };
   Eigen::MatrixXd Gr;  // B^T G B: the compliance on the slots' directions [s/kg]
   if (w.z_forward) {
-    forward_substitute(w);
+    // E B goes straight into row P_r of a row-major Y (in buffers of the thread, their capacity
+    // kept), with each row's range of nonzero columns; Y = L^-1 P E B then becomes Z.
+    thread_local std::vector<double> y_store;
+    thread_local std::vector<Eigen::Index> lo, hi;
+    y_store.assign(static_cast<std::size_t>(ndof * ncol), 0.0);
+    lo.assign(static_cast<std::size_t>(ndof), ncol);
+    hi.assign(static_cast<std::size_t>(ndof), 0);
+    const auto& perm = w.ldlt.permutationP().indices();
+    fill([&](Eigen::Index row, Eigen::Index col, double v) {
+      const auto r = static_cast<std::size_t>(perm[row]);
+      y_store[r * static_cast<std::size_t>(ncol) + static_cast<std::size_t>(col)] = v;
+      lo[r] = std::min(lo[r], col);
+      hi[r] = std::max(hi[r], col + 1);
+    });
+    forward_substitute(w.ldlt, y_store.data(), ncol, lo, hi);
+    w.resize_z(ndof, ncol, false);
+    auto Z = w.Z();
+    Z = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        y_store.data(), ndof, ncol);
     const Eigen::VectorXd& d = w.ldlt.vectorD();
     if (!(d.array() > 0.0).all()) {
-      Gr.noalias() = w.Z.transpose() * d.cwiseInverse().asDiagonal() * w.Z;
+      Gr.noalias() = Z.transpose() * d.cwiseInverse().asDiagonal() * Z;
     } else {
       // D > 0 (the projected tangent keeps the grains' Newton matrices positive definite when
       // they serve a compliance): S^T S with S = D^-1/2 Y, one triangle by a symmetric rank
-      // update (half the flops of the general product), mirrored.
-      const Eigen::MatrixXd S = d.cwiseInverse().cwiseSqrt().asDiagonal() * w.Z;
-      Gr.setZero(S.cols(), S.cols());
+      // update (half the flops of the general product), mirrored. S in a buffer of the thread.
+      thread_local std::vector<double> s_store;
+      s_store.resize(static_cast<std::size_t>(ndof * ncol));
+      Eigen::Map<Eigen::MatrixXd> S(s_store.data(), ndof, ncol);
+      S.noalias() = d.cwiseInverse().cwiseSqrt().asDiagonal() * Z;
+      Gr.setZero(ncol, ncol);
       Gr.selfadjointView<Eigen::Lower>().rankUpdate(S.transpose());
       Gr.triangularView<Eigen::StrictlyUpper>() = Gr.transpose();
     }
   } else {
+    w.resize_z(ndof, ncol, true);
+    auto Z = w.Z();
+    fill([&](Eigen::Index row, Eigen::Index col, double v) { Z(row, col) = v; });
     if (!w.lumped_group)
       for (Eigen::Index c = 0; c < ncol; ++c)
-        if (w.Z.col(c).squaredNorm() > 0) w.Z.col(c) = linear_solve(w, settings_, w.Z.col(c));
+        if (Z.col(c).squaredNorm() > 0)
+          Z.col(c) = linear_solve(w, settings_, Eigen::VectorXd(Z.col(c)));
     Gr.setZero(ncol, ncol);
     for (Eigen::Index i = 0; i < k; ++i) {
       const std::size_t s = static_cast<std::size_t>(w.slots[i]);
       Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(Dim, ncol);  // E_i^T Z
       for (std::int32_t q = slot_start_[s]; q < slot_start_[s + 1]; ++q)
-        rows += slot_weight_[q] * w.Z.middleRows(slot_node_[q] * Dim, Dim);
+        rows += slot_weight_[q] * Z.middleRows(slot_node_[q] * Dim, Dim);
       Gr.middleRows(w.z_col[static_cast<std::size_t>(i)], slot_rank_[s]) =
           slot_basis_[s].leftCols(slot_rank_[s]).transpose() * rows;
     }
   }
-  // G = B Gr B^T on the slots' full Dim x Dim blocks.
-  G.setZero(Dim * k, Dim * k);
+  // G = B Gr B^T on the slots' full Dim x Dim blocks: G_ij = B_i Gr_ij B_j^T with Gr_ij of the
+  // slots' ranks r_i x r_j, as T = B_i Gr_ij, then T B_j^T, each sum in ascending order, in
+  // fixed-size arrays (k^2 blocks per grain: no temporary on the heap).
+  G.resize(Dim * k, Dim * k);
   for (Eigen::Index j = 0; j < k; ++j) {
     const std::size_t sj = static_cast<std::size_t>(w.slots[j]);
-    const auto Bj = slot_basis_[sj].leftCols(slot_rank_[sj]);
+    const Mat<Dim>& Bj = slot_basis_[sj];
+    const int rj = slot_rank_[sj];
+    const Eigen::Index cj = w.z_col[static_cast<std::size_t>(j)];
     for (Eigen::Index i = 0; i < k; ++i) {
       const std::size_t si = static_cast<std::size_t>(w.slots[i]);
-      const auto Bi = slot_basis_[si].leftCols(slot_rank_[si]);
-      G.block(Dim * i, Dim * j, Dim, Dim).noalias() =
-          Bi *
-          Gr.block(w.z_col[static_cast<std::size_t>(i)], w.z_col[static_cast<std::size_t>(j)],
-                   slot_rank_[si], slot_rank_[sj]) *
-          Bj.transpose();
+      const Mat<Dim>& Bi = slot_basis_[si];
+      const int ri = slot_rank_[si];
+      const Eigen::Index ci = w.z_col[static_cast<std::size_t>(i)];
+      Mat<Dim> T = Mat<Dim>::Zero();  // B_i Gr_ij in its first r_j columns
+      for (int n = 0; n < rj; ++n)
+        for (int a = 0; a < Dim; ++a) {
+          double acc = 0;
+          for (int m = 0; m < ri; ++m) acc += Bi(a, m) * Gr(ci + m, cj + n);
+          T(a, n) = acc;
+        }
+      for (int b = 0; b < Dim; ++b)
+        for (int a = 0; a < Dim; ++a) {
+          double acc = 0;
+          for (int n = 0; n < rj; ++n) acc += T(a, n) * Bj(b, n);
+          G(Dim * i + a, Dim * j + b) = acc;
+        }
     }
   }
   return true;
@@ -401,7 +432,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     if (!changed) continue;
     // dv = A^-1 E B B^T dP = Z B^T dP (dP lies in the span of B), or P^T L^-T D^-1 Y B^T dP with
     // the forward-only response.
-    Eigen::VectorXd dv = w.Z * dP;
+    Eigen::VectorXd dv = w.Z() * dP;
     if (w.z_forward) {
       dv = w.ldlt.vectorD().cwiseInverse().asDiagonal() * dv;
       w.ldlt.matrixU().solveInPlace(dv);

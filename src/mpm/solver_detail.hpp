@@ -21,8 +21,24 @@ struct ImplicitSolver<Dim>::GrainWork : GrainField<Dim> {
   std::vector<std::int32_t> slots;  // contact slots of this grain (its compliance group)
   bool lumped_group = false;        // its group's response is M^-1 E (no factorisation)
   // A^-1 E B: response of all dofs to unit slot impulses along the slots' basis directions B
-  // (slot_basis_, columns slot after slot) [s/kg]
-  Eigen::MatrixXd Z;
+  // (slot_basis_, columns slot after slot) [s/kg], column-major in z_store, whose capacity is
+  // kept from call to call (the slots, and so Z's columns, change every step: a fresh matrix
+  // each time made the allocator zero-fill new pages)
+  std::vector<double> z_store;
+  Eigen::Index z_rows = 0, z_cols = 0;  // Z's size
+  Eigen::Map<Eigen::MatrixXd> Z() { return {z_store.data(), z_rows, z_cols}; }
+  // Makes Z rows x cols, its entries unset (0 with `zero`); z_store grows by a quarter more than
+  // it needs when it must grow.
+  void resize_z(Eigen::Index rows, Eigen::Index cols, bool zero) {
+    const auto n = static_cast<std::size_t>(rows * cols);
+    if (n > z_store.capacity()) z_store.reserve(n + n / 4);
+    if (zero)
+      z_store.assign(n, 0.0);
+    else
+      z_store.resize(n);
+    z_rows = rows;
+    z_cols = cols;
+  }
   std::vector<Eigen::Index> z_col;  // first column of each slot's directions in Z (size slots + 1)
   bool z_forward = false;           // Z holds Y = L^-1 P E instead (LDL^T: grain_compliance)
   std::int64_t z_factor = -1;       // the factorisation Z and G were computed with (-1: none)
