@@ -250,8 +250,7 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
     fill([&](Eigen::Index row, Eigen::Index col, double v) { Z(row, col) = v; });
     if (!w.lumped_group)
       for (Eigen::Index c = 0; c < ncol; ++c)
-        if (Z.col(c).squaredNorm() > 0)
-          Z.col(c) = linear_solve(w, settings_, Eigen::VectorXd(Z.col(c)));
+        if (Z.col(c).squaredNorm() > 0) Z.col(c) = linear_solve(w, settings_, Z.col(c));
     Gr.setZero(ncol, ncol);
     for (Eigen::Index i = 0; i < k; ++i) {
       const std::size_t s = static_cast<std::size_t>(w.slots[i]);

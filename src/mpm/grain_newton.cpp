@@ -324,8 +324,8 @@ void newton_solve(GrainField<Dim>& w, const TrialState<Dim>& trial, const Settin
                                   const materials::Law<D>&, bool, double);                      \
   template Eigen::VectorXd linear_solve<D, Eigen::VectorXd>(GrainField<D>&, const Settings<D>&, \
                                                             const Eigen::VectorXd&);            \
-  template Eigen::VectorXd linear_solve<D, Eigen::MatrixXd::ColXpr>(                            \
-      GrainField<D>&, const Settings<D>&, const Eigen::MatrixXd::ColXpr&);                      \
+  template Eigen::VectorXd linear_solve<D, Eigen::Map<Eigen::MatrixXd>::ColXpr>(                \
+      GrainField<D>&, const Settings<D>&, const Eigen::Map<Eigen::MatrixXd>::ColXpr&);          \
   template bool reuse_factor<D>(const GrainField<D>&, const Settings<D>&);                      \
   template void newton_solve<D>(GrainField<D>&, const TrialState<D>&, const Settings<D>&,       \
                                 const points::PointSet<D>&, const points::Grain&,               \

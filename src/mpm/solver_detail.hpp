@@ -22,8 +22,8 @@ struct ImplicitSolver<Dim>::GrainWork : GrainField<Dim> {
   bool lumped_group = false;        // its group's response is M^-1 E (no factorisation)
   // A^-1 E B: response of all dofs to unit slot impulses along the slots' basis directions B
   // (slot_basis_, columns slot after slot) [s/kg], column-major in z_store, whose capacity is
-  // kept from call to call (the slots, and so Z's columns, change every step: a fresh matrix
-  // each time made the allocator zero-fill new pages)
+  // kept from call to call (the slots, and so Z's columns, change every step: a matrix of a new
+  // size would be allocated anew each time)
   std::vector<double> z_store;
   Eigen::Index z_rows = 0, z_cols = 0;  // Z's size
   Eigen::Map<Eigen::MatrixXd> Z() { return {z_store.data(), z_rows, z_cols}; }
