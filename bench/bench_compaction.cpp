@@ -132,8 +132,8 @@ void dense_steps(benchmark::State& state, const std::string& path, int threads, 
       return;
     }
   stepper.solver().timers().clear();
-  double contacts = 0, active = 0, sweeps = 0, iters = 0, factorizations = 0, projected = 0,
-         wall = 0;
+  double contacts = 0, active = 0, sweeps = 0, iters = 0, factorizations = 0, dense = 0,
+         projected = 0, wall = 0;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto st = stepper.step();
@@ -147,6 +147,7 @@ void dense_steps(benchmark::State& state, const std::string& path, int threads, 
     sweeps += static_cast<double>(st.gs_sweeps);
     iters += st.iterations;
     factorizations += static_cast<double>(st.factorizations);
+    dense += static_cast<double>(st.dense_factorizations);
     projected += static_cast<double>(st.projected_factorizations);
   }
   const double steps = std::max<double>(1.0, static_cast<double>(state.iterations()));
@@ -178,6 +179,7 @@ void dense_steps(benchmark::State& state, const std::string& path, int threads, 
   state.counters["gs_sweeps"] = sweeps / steps;
   state.counters["newton_it"] = iters / steps;
   state.counters["factorizations"] = factorizations / steps;
+  state.counters["dense_factorizations"] = dense / steps;
   state.counters["projected"] = projected / steps;
   state.counters["retries"] = stepper.retries;
 }

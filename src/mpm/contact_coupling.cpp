@@ -209,7 +209,16 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
     }
   };
   Eigen::MatrixXd Gr;  // B^T G B: the compliance on the slots' directions [s/kg]
-  if (w.z_forward) {
+  if (w.z_forward && w.factor_dense) {
+    // Dense factor A = L L^T: Y = L^-1 E B by a blocked triangular solve, Gr = Y^T Y.
+    w.resize_z(ndof, ncol, true);
+    auto Z = w.Z();
+    fill([&](Eigen::Index row, Eigen::Index col, double v) { Z(row, col) = v; });
+    w.chol.template triangularView<Eigen::Lower>().solveInPlace(Z);
+    Gr.setZero(ncol, ncol);
+    Gr.selfadjointView<Eigen::Lower>().rankUpdate(Z.transpose());
+    Gr.triangularView<Eigen::StrictlyUpper>() = Gr.transpose();
+  } else if (w.z_forward) {
     // E B goes straight into row P_r of a row-major Y (in buffers of the thread, their capacity
     // kept), with each row's range of nonzero columns; Y = L^-1 P E B then becomes Z.
     thread_local std::vector<double> y_store;
@@ -432,7 +441,9 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     // dv = A^-1 E B B^T dP = Z B^T dP (dP lies in the span of B), or P^T L^-T D^-1 Y B^T dP with
     // the forward-only response.
     Eigen::VectorXd dv = w.Z() * dP;
-    if (w.z_forward) {
+    if (w.z_forward && w.factor_dense) {
+      w.chol.template triangularView<Eigen::Lower>().transpose().solveInPlace(dv);
+    } else if (w.z_forward) {
       dv = w.ldlt.vectorD().cwiseInverse().asDiagonal() * dv;
       w.ldlt.matrixU().solveInPlace(dv);
       dv = w.ldlt.permutationPinv() * dv;

@@ -82,6 +82,7 @@ void p2g(GrainField<Dim>& w, const grid::Grid<Dim>& grid, const Settings<Dim>& s
   w.iterations = 0;
   w.solves = 0;
   w.factorizations = 0;
+  w.dense_factorizations = 0;
   w.failure.clear();
   w.retryable = true;
   w.fail_point = -1;
@@ -346,7 +347,16 @@ void p2g(GrainField<Dim>& w, const grid::Grid<Dim>& grid, const Settings<Dim>& s
           w.value_index[((a * w.S + s) * Dim + i) * Dim + j] = pos - inner;
         }
     }
-  if (settings.linear_solver == LinearSolverKind::kLdlt) w.ldlt.analyzePattern(w.A);
+  w.dense = false;
+  if (settings.linear_solver == LinearSolverKind::kLdlt) {
+    // The symbolic analysis also serves the dense grains (their fallback when A is not positive
+    // definite: factorize); the fill of L decides (Settings::dense_fill).
+    w.ldlt.analyzePattern(w.A);
+    const auto n = static_cast<double>(w.A.rows());
+    w.dense =
+        w.A.rows() <= settings.dense_max_size &&
+        static_cast<double>(w.ldlt.factor_nonzeros()) >= settings.dense_fill * 0.5 * n * (n - 1);
+  }
   if (settings.linear_solver == LinearSolverKind::kLu) w.lu.analyzePattern(w.A);
 }
 

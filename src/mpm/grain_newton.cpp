@@ -179,6 +179,25 @@ void assemble_tangent(GrainField<Dim>& w, const TrialState<Dim>& trial,
   w.tangent_current = true;
 }
 
+namespace {
+
+// A = L L^T into w.chol (a dense grain, Settings::dense_fill): A's lower triangle copied in, then
+// Eigen's blocked in-place Cholesky. False when A is not positive definite.
+template <int Dim>
+bool dense_cholesky(GrainField<Dim>& w) {
+  const Eigen::Index n = w.A.rows();
+  if (w.chol.rows() != n) w.chol.resize(n, n);
+  for (Eigen::Index c = 0; c < n; ++c) {
+    w.chol.col(c).tail(n - c).setZero();
+    for (SpMat::InnerIterator it(w.A, c); it; ++it)
+      if (it.row() >= c) w.chol(it.row(), c) = it.value();
+  }
+  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(w.chol);
+  return llt.info() == Eigen::Success;
+}
+
+}  // namespace
+
 template <int Dim>
 bool factorize(GrainField<Dim>& w, const Settings<Dim>& settings, double dt) {
   const std::size_t na = w.m.size();
@@ -205,8 +224,12 @@ bool factorize(GrainField<Dim>& w, const Settings<Dim>& settings, double dt) {
   bool ok = true;
   switch (settings.linear_solver) {
     case LinearSolverKind::kLdlt:
-      w.ldlt.factorize(w.A);
-      ok = w.ldlt.info() == Eigen::Success;
+      w.factor_dense = w.dense && dense_cholesky(w);
+      if (!w.factor_dense) {
+        // Sparse LDL^T, also for a dense grain whose A is not positive definite.
+        w.ldlt.factorize(w.A);
+        ok = w.ldlt.info() == Eigen::Success;
+      }
       break;
     case LinearSolverKind::kLu:
       w.lu.factorize(w.A);
@@ -223,6 +246,7 @@ bool factorize(GrainField<Dim>& w, const Settings<Dim>& settings, double dt) {
   w.factor_in_step = ok;
   ++w.factor_count;
   ++w.factorizations;
+  if (w.factor_dense) ++w.dense_factorizations;
   return ok;
 }
 
@@ -245,7 +269,7 @@ bool prepare_factor(GrainField<Dim>& w, const TrialState<Dim>& trial, const Sett
   // tangent for the step; the Newton iterations still converge to the same state, linearly. A
   // grain without contact keeps the exact tangent (quadratic convergence).
   if (w.project_tangent || !compliance || settings.linear_solver != LinearSolverKind::kLdlt ||
-      !law.symmetric_tangent() || (w.ldlt.vectorD().array() > 0).all())
+      !law.symmetric_tangent() || w.factor_dense || (w.ldlt.vectorD().array() > 0).all())
     return true;
   w.project_tangent = true;
   ++w.projections;
@@ -256,8 +280,13 @@ bool prepare_factor(GrainField<Dim>& w, const TrialState<Dim>& trial, const Sett
 template <int Dim, class Rhs>
 Eigen::VectorXd linear_solve(GrainField<Dim>& w, const Settings<Dim>& settings, const Rhs& rhs) {
   switch (settings.linear_solver) {
-    case LinearSolverKind::kLdlt:
-      return w.ldlt.solve(rhs);
+    case LinearSolverKind::kLdlt: {
+      if (!w.factor_dense) return w.ldlt.solve(rhs);
+      Eigen::VectorXd x = rhs;  // L^-T L^-1 rhs
+      w.chol.template triangularView<Eigen::Lower>().solveInPlace(x);
+      w.chol.template triangularView<Eigen::Lower>().transpose().solveInPlace(x);
+      return x;
+    }
     case LinearSolverKind::kLu:
       return w.lu.solve(rhs);
     case LinearSolverKind::kCg: {

@@ -265,6 +265,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.iterations = std::max(stats.iterations, work_[g]->iterations);
     stats.linear_solves += work_[g]->solves;
     stats.factorizations += work_[g]->factorizations;
+    stats.dense_factorizations += work_[g]->dense_factorizations;
     stats.projected_factorizations += work_[g]->projections;
     stats.shrunk_domains += work_[g]->shrunk_domains;
   }
@@ -359,9 +360,9 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
   }
   {  // sums over the ranks' contacts, added in rank order
     std::vector<std::int64_t> n{
-        stats.contacts,         stats.active_contacts,          stats.linear_solves,
-        stats.factorizations,   stats.projected_factorizations, stats.shrunk_domains,
-        stats.oversized_domains};
+        stats.contacts,          stats.active_contacts,          stats.linear_solves,
+        stats.factorizations,    stats.projected_factorizations, stats.shrunk_domains,
+        stats.oversized_domains, stats.dense_factorizations};
     over_ranks(n, &parallel::Comm::sum);
     std::vector<std::int64_t> it{-stats.iterations};
     over_ranks(it, &parallel::Comm::min);
@@ -372,6 +373,7 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     stats.projected_factorizations = n[4];
     stats.shrunk_domains = n[5];
     stats.oversized_domains = n[6];
+    stats.dense_factorizations = n[7];
     stats.iterations = static_cast<int>(-it[0]);
     over_ranks(wall_f, &parallel::Comm::sum);  // one rank holds each grain's wall contacts: exact
   }

@@ -4,6 +4,7 @@
 /// residual), assemble_tangent, factorize / prepare_factor, linear_solve, newton_solve, g2p_check
 /// and g2p_commit. ImplicitSolver calls them grain by grain; each takes what it reads explicitly,
 /// so that a test can run one stage on one grain (tests/unit/mpm).
+#include <Eigen/Cholesky>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
@@ -22,6 +23,13 @@ namespace mpmcd::mpm {
 
 /// Sparse matrix of a grain's Newton system (column-major, doubles).
 using SpMat = Eigen::SparseMatrix<double>;
+
+/// Eigen's SimplicialLDLT with the size of its factor L known after the symbolic analysis.
+class SparseLdlt : public Eigen::SimplicialLDLT<SpMat> {
+ public:
+  /// Non-zeros of L below the diagonal once analyzePattern has run [-].
+  Eigen::Index factor_nonzeros() const { return m_matrix.outerIndexPtr()[m_matrix.outerSize()]; }
+};
 
 /// Prescribed velocity components per global grid node, from a list of VelocityBC (later sets
 /// override earlier ones).
@@ -138,25 +146,31 @@ struct GrainField {
   std::vector<Mat<Dim>> K_blk;            ///< active x S: tangent blocks K_ab [N/m]
   SpMat A;                                ///< Newton matrix M + theta^2 dt^2 K [kg]
   std::vector<std::int64_t> value_index;  ///< (active x S x Dim x Dim) -> A.valuePtr() index
-  Eigen::SimplicialLDLT<SpMat> ldlt;      ///< LDL^T factorisation (LinearSolverKind::kLdlt)
-  Eigen::SparseLU<SpMat> lu;              ///< LU factorisation (LinearSolverKind::kLu)
+  SparseLdlt ldlt;                        ///< LDL^T factorisation (LinearSolverKind::kLdlt)
+  /// kLdlt grains with a dense factor (Settings::dense_fill, decided with the pattern): the
+  /// factorisations are LL^T of the dense A, L in chol's lower triangle (its upper one is unused)
+  bool dense = false;
+  bool factor_dense = false;  ///< the current factorisation is chol's (else ldlt's)
+  Eigen::MatrixXd chol;       ///< dense Cholesky factor L of A, lower triangle [sqrt(kg)]
+  Eigen::SparseLU<SpMat> lu;  ///< LU factorisation (LinearSolverKind::kLu)
   Eigen::ConjugateGradient<SpMat, Eigen::Lower | Eigen::Upper> cg;  ///< CG (kCg)
   Eigen::VectorXd rhs, sol;  ///< the last Newton system's right-hand side and solution
   // Newton bookkeeping.
-  bool converged = false;           ///< converged in the current step
-  bool solved_once = false;         ///< a Newton update was applied in the current step
-  int iterations = 0;               ///< Newton iterations of the current step [-]
-  std::int64_t solves = 0;          ///< linear solves in the current step [-]
-  std::int64_t factorizations = 0;  ///< factorisations in the current step [-]
-  double cg_work = 0;               ///< CG iterations x matrix non-zeros of the last solve [-]
-  double res_norm = 0;              ///< |R| [N s]
-  double res_ref = 0;               ///< reference scale of |R| [N s]
-  double dv_norm = 0;               ///< |dv|_M of the last update [sqrt(kg) m/s]
-  bool dv_from_contact = false;     ///< that update was the response to an impulse change
-  std::vector<double> history;      ///< |R| / reference per iteration [-]
-  std::string failure;              ///< why the grain failed ("" if it did not)
-  bool retryable = true;            ///< a smaller dt may cure the failure
-  std::int64_t fail_point = -1;     ///< point involved in the failure, -1 if none
+  bool converged = false;                 ///< converged in the current step
+  bool solved_once = false;               ///< a Newton update was applied in the current step
+  int iterations = 0;                     ///< Newton iterations of the current step [-]
+  std::int64_t solves = 0;                ///< linear solves in the current step [-]
+  std::int64_t factorizations = 0;        ///< factorisations in the current step [-]
+  std::int64_t dense_factorizations = 0;  ///< of those, dense LL^T ones [-]
+  double cg_work = 0;            ///< CG iterations x matrix non-zeros of the last solve [-]
+  double res_norm = 0;           ///< |R| [N s]
+  double res_ref = 0;            ///< reference scale of |R| [N s]
+  double dv_norm = 0;            ///< |dv|_M of the last update [sqrt(kg) m/s]
+  bool dv_from_contact = false;  ///< that update was the response to an impulse change
+  std::vector<double> history;   ///< |R| / reference per iteration [-]
+  std::string failure;           ///< why the grain failed ("" if it did not)
+  bool retryable = true;         ///< a smaller dt may cure the failure
+  std::int64_t fail_point = -1;  ///< point involved in the failure, -1 if none
   /// Energy ledger terms of the step (StepStats): kinetic energy of the points before the step
   /// and after its G2P, and of the grid field at v^n [J].
   double kin_points_n = 0, kin_points = 0, kin_grid_n = 0;

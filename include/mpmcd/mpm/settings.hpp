@@ -47,6 +47,15 @@ struct Settings {
   /// compliance computed from it) in the later iterations; refactorised when the residual
   /// stalls. Same converged answer, fewer factorisations (docs/accuracy.md, cost).
   bool modified_newton = true;
+  /// With kLdlt, a grain whose sparse factor L fills at least this fraction of its strict lower
+  /// triangle (from the symbolic analysis) and whose system has at most dense_max_size unknowns
+  /// is factorised dense instead, as LL^T with Eigen's blocked kernels: the 3D CPDI grains
+  /// (fill 0.6-0.7) factorise 4x faster that way; 2D grains at d/8 (fill 0.4) stay sparse
+  /// (docs/three_d.md, "Dense grain factorisations"). Off by default (above 1: never) until
+  /// the builds with MPMCD_NATIVE, where it pays, pass the whole suite; 0.5 is the measured
+  /// choice there [-].
+  double dense_fill = 2.0;
+  int dense_max_size = 3000;  ///< largest system factorised dense (n^2 doubles per grain) [-]
   Vec<Dim> gravity = Vec<Dim>::Zero();  ///< body acceleration [m/s^2]
   ContactSettings<Dim> contact;         ///< contact between grains and with walls
 };

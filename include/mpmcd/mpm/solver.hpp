@@ -33,6 +33,8 @@ struct StepStats {
   int iterations = 0;               ///< Newton iterations (max over grains)
   std::int64_t linear_solves = 0;   ///< linear solves, summed over grains
   std::int64_t factorizations = 0;  ///< Newton-matrix factorisations, summed over grains
+  /// Of those, the dense LL^T ones (Settings::dense_fill), summed over grains [-].
+  std::int64_t dense_factorizations = 0;
   /// Factorisations redone with the projected tangent because M + theta^2 dt^2 K was indefinite
   /// (docs/accuracy.md, "Indefinite Newton matrices"), summed over grains [-].
   std::int64_t projected_factorizations = 0;
