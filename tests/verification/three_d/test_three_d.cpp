@@ -88,6 +88,19 @@ void surface_contact(mpm::Settings<3>& s) {
   s.contact.active_set = true;
 }
 
+// Two balls of radius R [m] at +-v0 [m/s] along x, a cell h [m] of gap on each side of the middle
+// of a 12 x 6 x 6 mm grid (24 x 12 x 12 cells for h = 0.5 mm), 2^3 points per cell.
+mpm::Model<3> two_spheres(double h, double R, double v0) {
+  mpm::Model<3> model;
+  model.grid = grid::Grid<3>(Vec<3>::Zero(), h, IVec<3>(24, 12, 12));
+  model.add_material(materials::make_law<3>("neo_hookean", {{"lambda", kLambda}, {"mu", kMu}}),
+                     kRho);
+  const double xa = 6e-3 - R - h, xb = 6e-3 + R + h, y = 3e-3, z = 3e-3;
+  add_ball(model, Vec<3>(xa, y, z), R, 2, [&](const Vec<3>&) { return Vec<3>(v0, 0, 0); });
+  add_ball(model, Vec<3>(xb, y, z), R, 2, [&](const Vec<3>&) { return Vec<3>(-v0, 0, 0); });
+  return model;
+}
+
 }  // namespace
 
 // Confined (uniaxial-strain) compression to s = 0.9 in 10 steps and simple shear to γ = 0.2 in 10
@@ -189,13 +202,7 @@ TEST(ThreeD, SphereRestingOnAWallCarriesItsWeight) {
 TEST(ThreeD, HeadOnImpactOfTwoSpheresConservesMomentumAndSeparates) {
   for (const bool faces : {false, true}) {
     const double h = 0.5e-3, R = 1.5e-3, v0 = 1.0;
-    mpm::Model<3> model;
-    model.grid = grid::Grid<3>(Vec<3>::Zero(), h, IVec<3>(24, 12, 12));  // 12 x 6 x 6 mm
-    model.add_material(materials::make_law<3>("neo_hookean", {{"lambda", kLambda}, {"mu", kMu}}),
-                       kRho);
-    const double xa = 6e-3 - R - h, xb = 6e-3 + R + h, y = 3e-3, z = 3e-3;
-    add_ball(model, Vec<3>(xa, y, z), R, 2, [&](const Vec<3>&) { return Vec<3>(v0, 0, 0); });
-    add_ball(model, Vec<3>(xb, y, z), R, 2, [&](const Vec<3>&) { return Vec<3>(-v0, 0, 0); });
+    auto model = two_spheres(h, R, v0);
     auto s = contact_settings({});
     if (faces) surface_contact(s);
     mpm::ImplicitSolver<3> solver(model.grid, s, model.points, model.grains, model.law_ptrs());
@@ -221,13 +228,7 @@ constexpr int kDenseSteps = 250;  // through the contact of the two spheres
 TEST(ThreeD, DenseAndSparseGrainFactorisationsTakeTheSameSteps) {
   const double h = 0.5e-3, R = 1.5e-3, v0 = 1.0;
   const auto run = [&](double dense_fill, std::int64_t& dense, std::int64_t& all) {
-    mpm::Model<3> model;
-    model.grid = grid::Grid<3>(Vec<3>::Zero(), h, IVec<3>(24, 12, 12));
-    model.add_material(materials::make_law<3>("neo_hookean", {{"lambda", kLambda}, {"mu", kMu}}),
-                       kRho);
-    const double xa = 6e-3 - R - h, xb = 6e-3 + R + h, y = 3e-3, z = 3e-3;
-    add_ball(model, Vec<3>(xa, y, z), R, 2, [&](const Vec<3>&) { return Vec<3>(v0, 0, 0); });
-    add_ball(model, Vec<3>(xb, y, z), R, 2, [&](const Vec<3>&) { return Vec<3>(-v0, 0, 0); });
+    auto model = two_spheres(h, R, v0);
     auto s = contact_settings({});
     surface_contact(s);
     s.dense_fill = dense_fill;
