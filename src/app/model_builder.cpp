@@ -439,6 +439,7 @@ mpm::Settings<Dim> build_settings(const io::Config& cfg, const mpm::Model<Dim>& 
   s.flip = cfg.solver.flip;
   s.affine = cfg.solver.affine;
   s.modified_newton = cfg.solver.modified_newton;
+  s.dense_fill = cfg.solver.dense_fill;
   if (cfg.loads.gravity.size() == Dim) s.gravity = vec_of<Dim>(cfg.loads.gravity);
   auto& c = s.contact;
   c.enabled = contact_enabled(cfg, model.grains.size());

@@ -320,6 +320,12 @@ Schema build_schema() {
                         "modified Newton: factorise the Newton matrix once per step and reuse it "
                         "(and the contact compliance) in later iterations, refactorising when the "
                         "residual stalls; same converged answer, fewer factorisations")
+           .default_of_member(),
+       KeySpec::number("dense_fill", &SolverSection::dense_fill, "",
+                       "with ldlt, a grain whose sparse factor fills at least this fraction of "
+                       "its lower triangle is factorised dense (LL^T, blocked kernels); pays "
+                       "for 3D CPDI grains in an MPMCD_NATIVE build (0.5); above 1: never")
+           .greater_than(0.0)
            .default_of_member()});
 
   add_interaction_tables(s);

@@ -110,6 +110,9 @@ struct SolverSection {
   double flip = 1.0;            ///< FLIP fraction of the G2P velocity update (1 = FLIP, 0 = PIC)
   bool affine = false;          ///< affine P2G with the points' velocity gradients (APIC/TPIC)
   bool modified_newton = true;  ///< reuse the step's first factorisation (modified Newton)
+  /// Grains whose sparse factor fills at least this fraction of its triangle are factorised
+  /// dense (Settings::dense_fill; above 1: never) [-].
+  double dense_fill = 2.0;
 };
 
 /// [[contact.pairs]]: friction between two materials.
