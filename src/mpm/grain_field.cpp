@@ -10,6 +10,32 @@
 
 namespace mpmcd::mpm {
 
+void SparseLdlt::analyze(const SpMat& A) {
+  analyzePattern(A);
+  from_a_.clear();
+  if (m_P.size() == 0) return;  // no ordering: factorize_mapped is Eigen's factorize
+  // A with the positions of its stored values as values, permuted as Eigen's factorize permutes
+  // A (SimplicialCholeskyBase::factorize): each value of P A P^T's upper triangle then names the
+  // value of A it is copied from.
+  SpMat idx = A;
+  for (Eigen::Index k = 0; k < idx.nonZeros(); ++k) idx.valuePtr()[k] = static_cast<double>(k);
+  ap_.resize(A.rows(), A.cols());
+  ap_.selfadjointView<Eigen::Upper>() = idx.selfadjointView<UpLo>().twistedBy(m_P);
+  from_a_.resize(static_cast<std::size_t>(ap_.nonZeros()));
+  for (std::size_t k = 0; k < from_a_.size(); ++k) from_a_[k] = static_cast<int>(ap_.valuePtr()[k]);
+}
+
+void SparseLdlt::factorize_mapped(const SpMat& A) {
+  if (from_a_.empty()) {
+    factorize(A);
+    return;
+  }
+  const double* a = A.valuePtr();
+  double* v = ap_.valuePtr();
+  for (std::size_t k = 0; k < from_a_.size(); ++k) v[k] = a[from_a_[k]];
+  factorize_preordered<true>(ap_);
+}
+
 namespace {
 template <class T>
 void reset(std::vector<T>& v, std::size_t n, const T& value) {
@@ -351,7 +377,7 @@ void p2g(GrainField<Dim>& w, const grid::Grid<Dim>& grid, const Settings<Dim>& s
   if (settings.linear_solver == LinearSolverKind::kLdlt) {
     // The symbolic analysis also serves the dense grains (their fallback when A is not positive
     // definite: factorize); the fill of L decides (Settings::dense_fill).
-    w.ldlt.analyzePattern(w.A);
+    w.ldlt.analyze(w.A);
     const auto n = static_cast<double>(w.A.rows());
     w.dense =
         w.A.rows() <= settings.dense_max_size &&

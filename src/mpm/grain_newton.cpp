@@ -227,7 +227,7 @@ bool factorize(GrainField<Dim>& w, const Settings<Dim>& settings, double dt) {
       w.factor_dense = w.dense && dense_cholesky(w);
       if (!w.factor_dense) {
         // Sparse LDL^T, also for a dense grain whose A is not positive definite.
-        w.ldlt.factorize(w.A);
+        w.ldlt.factorize_mapped(w.A);
         ok = w.ldlt.info() == Eigen::Success;
       }
       break;

@@ -24,11 +24,23 @@ namespace mpmcd::mpm {
 /// Sparse matrix of a grain's Newton system (column-major, doubles).
 using SpMat = Eigen::SparseMatrix<double>;
 
-/// Eigen's SimplicialLDLT with the size of its factor L known after the symbolic analysis.
+/// Eigen's SimplicialLDLT with the size of its factor L known after the symbolic analysis, and
+/// a numeric factorisation that gathers the permuted matrix P A P^T through a map made once per
+/// pattern instead of permuting A (a fresh matrix and two passes) at every factorisation.
 class SparseLdlt : public Eigen::SimplicialLDLT<SpMat> {
  public:
   /// Non-zeros of L below the diagonal once analyzePattern has run [-].
   Eigen::Index factor_nonzeros() const { return m_matrix.outerIndexPtr()[m_matrix.outerSize()]; }
+  /// The symbolic analysis of A's pattern (Eigen's AMD ordering and elimination tree) and the
+  /// map from the upper triangle of P A P^T to A's stored values.
+  void analyze(const SpMat& A);
+  /// The numeric LDL^T of A (the pattern given to analyze): the same arithmetic as Eigen's
+  /// factorize(A) on the same permuted matrix, so the same bits.
+  void factorize_mapped(const SpMat& A);
+
+ private:
+  SpMat ap_;                 ///< upper triangle of P A P^T (Eigen's permuted input)
+  std::vector<int> from_a_;  ///< ap_'s k-th value is A.valuePtr()[from_a_[k]] (empty: no map)
 };
 
 /// Prescribed velocity components per global grid node, from a list of VelocityBC (later sets
