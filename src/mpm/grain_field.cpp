@@ -382,6 +382,7 @@ void p2g(GrainField<Dim>& w, const grid::Grid<Dim>& grid, const Settings<Dim>& s
     w.dense =
         w.A.rows() <= settings.dense_max_size &&
         static_cast<double>(w.ldlt.factor_nonzeros()) >= settings.dense_fill * 0.5 * n * (n - 1);
+    if (w.dense) w.ldlt.release_map();
   }
   if (settings.linear_solver == LinearSolverKind::kLu) w.lu.analyzePattern(w.A);
 }

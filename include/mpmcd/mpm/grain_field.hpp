@@ -37,6 +37,12 @@ class SparseLdlt : public Eigen::SimplicialLDLT<SpMat> {
   /// The numeric LDL^T of A (the pattern given to analyze): the same arithmetic as Eigen's
   /// factorize(A) on the same permuted matrix, so the same bits.
   void factorize_mapped(const SpMat& A);
+  /// Frees the map (a grain factorised dense uses factorize_mapped only as its fallback, which
+  /// then permutes A as Eigen does).
+  void release_map() {
+    ap_ = SpMat();
+    from_a_ = std::vector<int>();
+  }
 
  private:
   SpMat ap_;                 ///< upper triangle of P A P^T (Eigen's permuted input)
