@@ -206,22 +206,11 @@ bool factorize(GrainField<Dim>& w, const Settings<Dim>& settings, double dt) {
   // Newton matrix dR/dv^{n+1} = M + theta^2 dt^2 K (method.md §2); prescribed rows and columns
   // are replaced by m_I on the diagonal so the matrix stays symmetric positive definite.
   const int center = (w.S - 1) / 2;
-  // Most grains have no prescribed node: their entries skip the masks (same values).
-  const bool prescribed =
-      std::any_of(w.mask.begin(), w.mask.end(), [](std::uint8_t mk) { return mk != 0; });
   for (std::size_t a = 0; a < na; ++a)
     for (int s = 0; s < w.S; ++s) {
       const std::int32_t b = w.stencil_nb[a * w.S + s];
       if (b < 0) continue;
       const Mat<Dim>& K = w.K_blk[a * w.S + s];
-      const std::int64_t* at = &w.value_index[(a * w.S + s) * Dim * Dim];
-      if (!prescribed) {
-        for (int i = 0; i < Dim; ++i)
-          for (int j = 0; j < Dim; ++j) val[at[i * Dim + j]] = c * K(i, j);
-        if (s == center)
-          for (int i = 0; i < Dim; ++i) val[at[i * Dim + i]] += w.m[a];
-        continue;
-      }
       for (int i = 0; i < Dim; ++i)
         for (int j = 0; j < Dim; ++j) {
           double v = c * K(i, j);
@@ -229,7 +218,7 @@ bool factorize(GrainField<Dim>& w, const Settings<Dim>& settings, double dt) {
           const bool fixed_row = w.mask[a] & (1u << i);
           const bool fixed_col = w.mask[b] & (1u << j);
           if (fixed_row || fixed_col) v = (s == center && i == j) ? w.m[a] : 0.0;
-          val[at[i * Dim + j]] = v;
+          val[w.value_index[((a * w.S + s) * Dim + i) * Dim + j]] = v;
         }
     }
   bool ok = true;
