@@ -10,8 +10,7 @@
 
 namespace mpmcd::mpm {
 
-void SparseLdlt::analyze(const SpMat& A) {
-  analyzePattern(A);
+void SparseLdlt::map_pattern(const SpMat& A) {
   from_a_.clear();
   if (m_P.size() == 0) return;  // no ordering: factorize_mapped is Eigen's factorize
   // A with the positions of its stored values as values, permuted as Eigen's factorize permutes
@@ -377,12 +376,16 @@ void p2g(GrainField<Dim>& w, const grid::Grid<Dim>& grid, const Settings<Dim>& s
   if (settings.linear_solver == LinearSolverKind::kLdlt) {
     // The symbolic analysis also serves the dense grains (their fallback when A is not positive
     // definite: factorize); the fill of L decides (Settings::dense_fill).
-    w.ldlt.analyze(w.A);
+    w.ldlt.analyzePattern(w.A);
     const auto n = static_cast<double>(w.A.rows());
     w.dense =
         w.A.rows() <= settings.dense_max_size &&
         static_cast<double>(w.ldlt.factor_nonzeros()) >= settings.dense_fill * 0.5 * n * (n - 1);
-    if (w.dense) w.ldlt.release_map();
+    // Only sparse grains gather P A P^T through the map (a dense one's fallback permutes A).
+    if (w.dense)
+      w.ldlt.clear_map();
+    else
+      w.ldlt.map_pattern(w.A);
   }
   if (settings.linear_solver == LinearSolverKind::kLu) w.lu.analyzePattern(w.A);
 }

@@ -31,18 +31,18 @@ class SparseLdlt : public Eigen::SimplicialLDLT<SpMat> {
  public:
   /// Non-zeros of L below the diagonal once analyzePattern has run [-].
   Eigen::Index factor_nonzeros() const { return m_matrix.outerIndexPtr()[m_matrix.outerSize()]; }
-  /// The symbolic analysis of A's pattern (Eigen's AMD ordering and elimination tree) and the
-  /// map from the upper triangle of P A P^T to A's stored values.
-  void analyze(const SpMat& A);
-  /// The numeric LDL^T of A (the pattern given to analyze): the same arithmetic as Eigen's
-  /// factorize(A) on the same permuted matrix, so the same bits.
-  void factorize_mapped(const SpMat& A);
-  /// Frees the map (a grain factorised dense uses factorize_mapped only as its fallback, which
-  /// then permutes A as Eigen does).
-  void release_map() {
+  /// The map from the upper triangle of P A P^T to A's stored values, for A's pattern after
+  /// analyzePattern(A) (Eigen's AMD ordering P); grains factorised dense do without it.
+  void map_pattern(const SpMat& A);
+  /// Frees the map (factorize_mapped then permutes A as Eigen's factorize does).
+  void clear_map() {
     ap_ = SpMat();
     from_a_ = std::vector<int>();
   }
+  /// The numeric LDL^T of A (the pattern given to analyzePattern): with the map, the same
+  /// arithmetic as Eigen's factorize(A) on the same permuted matrix, so the same bits; without
+  /// it, Eigen's factorize(A).
+  void factorize_mapped(const SpMat& A);
 
  private:
   SpMat ap_;                 ///< upper triangle of P A P^T (Eigen's permuted input)
