@@ -63,11 +63,9 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
                          const Vec<Dim>& n) {
     const Vec<Dim>& ne = p.contacts[static_cast<std::size_t>(e.contact)].normal;
     if (r >= ng) return e.sign * sign * ne.dot(n) / p.slots[slot].mass;  // lumped: R = I / m
-    const Eigen::MatrixXd& G = p.groups[r].G;
-    return e.sign * sign *
-           ne.dot(
-               G.template block<Dim, Dim>(Dim * p.slots[e.slot].local, Dim * p.slots[slot].local) *
-               n);
+    const Mat<Dim> G = p.groups[r].block(static_cast<std::size_t>(p.slots[e.slot].local),
+                                         static_cast<std::size_t>(p.slots[slot].local));
+    return e.sign * sign * ne.dot(G * n);
   };
   static const std::vector<Entry> kNone;
   const auto lists = [&](const Contact<Dim>& k) {

@@ -23,7 +23,8 @@ template <int Dim>
 Mat<Dim> self_block(const Problem<Dim>& p, std::int32_t s) {
   const Slot<Dim>& sl = p.slots[s];
   if (sl.group < 0) return Mat<Dim>::Identity() / sl.mass;
-  return p.groups[sl.group].G.template block<Dim, Dim>(Dim * sl.local, Dim * sl.local);
+  return p.groups[sl.group].block(static_cast<std::size_t>(sl.local),
+                                  static_cast<std::size_t>(sl.local));
 }
 
 // The slots' velocities during the sweeps, each group's slots stored contiguously in their local
@@ -48,17 +49,19 @@ void respond(const Problem<Dim>& p, SlotVelocities<Dim>& v, std::int32_t s, cons
     v[s] += dP / sl.mass;
     return;
   }
-  // v_j += G_{j,s} dP for every slot j of the group: rows of G's columns Dim s .. Dim s + Dim - 1
-  // against the group's contiguous velocities, each entry summed over the columns in order (the
-  // bits of G.block(Dim j, Dim s) * dP).
-  const Group& g = p.groups[sl.group];
-  const auto rows = static_cast<std::size_t>(g.G.rows());
-  const double* col = g.G.data() + static_cast<std::size_t>(Dim * sl.local) * rows;
-  double* out = v.value[static_cast<std::size_t>(v.first[sl.group])].data();
-  for (std::size_t i = 0; i < rows; ++i) {
-    double acc = col[i] * dP[0];
-    for (int d = 1; d < Dim; ++d) acc += col[static_cast<std::size_t>(d) * rows + i] * dP[d];
-    out[i] += acc;
+  // v_j += G_{j,s} dP for every slot j of the group, G_{j,s} = B_j Gr_js B_s^T (Group::block),
+  // against the group's contiguous velocities, each entry summed over the components of dP in
+  // order.
+  const Group<Dim>& g = p.groups[sl.group];
+  const auto s_local = static_cast<std::size_t>(sl.local);
+  Vec<Dim>* out = &v.value[static_cast<std::size_t>(v.first[sl.group])];
+  for (std::size_t j = 0; j < g.slots.size(); ++j) {
+    const Mat<Dim> G = g.block(j, s_local);
+    for (int a = 0; a < Dim; ++a) {
+      double acc = G(a, 0) * dP[0];
+      for (int d = 1; d < Dim; ++d) acc += G(a, d) * dP[d];
+      out[j][a] += acc;
+    }
   }
 }
 
@@ -211,7 +214,8 @@ Mat<Dim> cross_block(const Problem<Dim>& p, std::int32_t s, std::int32_t t) {
   if (s == t) return self_block(p, s);
   const Slot<Dim>&ss = p.slots[s], &st = p.slots[t];
   if (ss.group < 0 || ss.group != st.group) return Mat<Dim>::Zero();
-  return p.groups[ss.group].G.template block<Dim, Dim>(Dim * ss.local, Dim * st.local);
+  return p.groups[ss.group].block(static_cast<std::size_t>(ss.local),
+                                  static_cast<std::size_t>(st.local));
 }
 
 // Largest node block solved exactly (2^k active sets).

@@ -1,6 +1,7 @@
 // A contact problem as text, to replay a step's problem outside a run (write_problem,
 // read_problem; include/mpmcd/contact/problem.hpp): the contact law unless it is the default
-// ("law <name>"), one line per slot and contact, each group's slots and compliance matrix, 17
+// ("law <name>"), one line per slot and contact, each group's slots, their directions and the
+// compliance on them (v2; v1 files, with each group's full Dim k x Dim k matrix, are read too), 17
 // significant digits.
 #include <fmt/format.h>
 
@@ -18,7 +19,7 @@ template <int Dim>
 void write_problem(const Problem<Dim>& p, const std::string& path) {
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw std::runtime_error("cannot write " + path);
-  out << "# mpmcd contact problem v1\n" << fmt::format("dim {}\ndt {:.17g}\n", Dim, p.dt);
+  out << "# mpmcd contact problem v2\n" << fmt::format("dim {}\ndt {:.17g}\n", Dim, p.dt);
   if (p.law != Problem<Dim>{}.law) out << "law " << p.law << "\n";  // the default law: no line
   out << "slots " << p.slots.size() << "\n";
   for (const auto& s : p.slots) {
@@ -40,9 +41,16 @@ void write_problem(const Problem<Dim>& p, const std::string& path) {
     out << g.slots.size();
     for (auto sl : g.slots) out << " " << sl;
     out << "\n";
-    for (Eigen::Index i = 0; i < g.G.rows(); ++i) {
-      for (Eigen::Index j = 0; j < g.G.cols(); ++j)
-        out << fmt::format("{}{:.17g}", j ? " " : "", g.G(i, j));
+    // v2: per slot "rank" and its directions (rank columns of Dim numbers), then Gr's rows.
+    for (std::size_t j = 0; j < g.slots.size(); ++j) {
+      out << g.rank(j);
+      for (int m = 0; m < g.rank(j); ++m)
+        for (int d = 0; d < Dim; ++d) out << fmt::format(" {:.17g}", g.basis[j](d, m));
+      out << "\n";
+    }
+    for (Eigen::Index i = 0; i < g.Gr.rows(); ++i) {
+      for (Eigen::Index j = 0; j < g.Gr.cols(); ++j)
+        out << fmt::format("{}{:.17g}", j ? " " : "", g.Gr(i, j));
       out << "\n";
     }
   }
@@ -55,9 +63,11 @@ Problem<Dim> read_problem(const std::string& path) {
   Problem<Dim> p;
   std::string line;
   std::int64_t lineno = 0;
+  int version = 1;  // from the header comment "# mpmcd contact problem v<N>"
   auto next = [&](const char* what) -> std::istringstream {
     while (std::getline(in, line)) {
       ++lineno;
+      if (line.rfind("# mpmcd contact problem v2", 0) == 0) version = 2;
       if (!line.empty() && line[0] != '#') return std::istringstream(line);
     }
     throw InputError(path, lineno, what, "unexpected end of file");
@@ -152,10 +162,34 @@ Problem<Dim> read_problem(const std::string& path) {
     for (auto sl : g.slots)
       if (sl < 0 || sl >= static_cast<std::int32_t>(p.slots.size()))
         throw InputError(path, lineno, "group", "slot index out of range");
-    g.G.resize(static_cast<Eigen::Index>(Dim * k), static_cast<Eigen::Index>(Dim * k));
-    for (Eigen::Index i = 0; i < g.G.rows(); ++i) {
+    if (version == 1) {  // the full Dim k x Dim k compliance
+      Eigen::MatrixXd G(static_cast<Eigen::Index>(Dim * k), static_cast<Eigen::Index>(Dim * k));
+      for (Eigen::Index i = 0; i < G.rows(); ++i) {
+        auto row = next("group matrix");
+        for (Eigen::Index j = 0; j < G.cols(); ++j) row >> G(i, j);
+        check(row, "group matrix");
+      }
+      g.set_full(G);
+      continue;
+    }
+    g.basis.assign(k, Mat<Dim>::Zero());
+    g.col.assign(k + 1, 0);
+    for (std::size_t j = 0; j < k; ++j) {
+      auto row = next("group directions");
+      int r = 0;
+      row >> r;
+      if (r < 1 || r > Dim)
+        throw InputError(path, lineno, "group directions",
+                         fmt::format("expected a rank in [1, {}]", Dim));
+      for (int m = 0; m < r; ++m)
+        for (int d = 0; d < Dim; ++d) row >> g.basis[j](d, m);
+      check(row, "group directions");
+      g.col[j + 1] = g.col[j] + r;
+    }
+    g.Gr.resize(g.col[k], g.col[k]);
+    for (Eigen::Index i = 0; i < g.Gr.rows(); ++i) {
       auto row = next("group matrix");
-      for (Eigen::Index j = 0; j < g.G.cols(); ++j) row >> g.G(i, j);
+      for (Eigen::Index j = 0; j < g.Gr.cols(); ++j) row >> g.Gr(i, j);
       check(row, "group matrix");
     }
   }

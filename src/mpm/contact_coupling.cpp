@@ -180,7 +180,7 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
   }
   const auto k = static_cast<Eigen::Index>(w.slots.size());
   const auto ndof = static_cast<Eigen::Index>(w.m.size() * Dim);
-  Eigen::MatrixXd& G = problem_.groups[problem_.slots[w.slots[0]].group].G;
+  contact::Group<Dim>& group = problem_.groups[problem_.slots[w.slots[0]].group];
   w.z_col.assign(static_cast<std::size_t>(k) + 1, 0);
   for (Eigen::Index j = 0; j < k; ++j)
     w.z_col[static_cast<std::size_t>(j) + 1] =
@@ -208,7 +208,7 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
         }
     }
   };
-  Eigen::MatrixXd Gr;  // B^T G B: the compliance on the slots' directions [s/kg]
+  Eigen::MatrixXd& Gr = group.Gr;  // B^T G B: the compliance on the slots' directions [s/kg]
   if (w.z_forward && w.factor_dense) {
     // Dense factor A = L L^T: Y = L^-1 E B by a blocked triangular solve, Gr = Y^T Y.
     w.resize_z(ndof, ncol, true);
@@ -270,35 +270,11 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
           slot_basis_[s].leftCols(slot_rank_[s]).transpose() * rows;
     }
   }
-  // G = B Gr B^T on the slots' full Dim x Dim blocks: G_ij = B_i Gr_ij B_j^T with Gr_ij of the
-  // slots' ranks r_i x r_j, as T = B_i Gr_ij, then T B_j^T, each sum in ascending order, in
-  // fixed-size arrays (k^2 blocks per grain: no temporary on the heap).
-  G.resize(Dim * k, Dim * k);
-  for (Eigen::Index j = 0; j < k; ++j) {
-    const std::size_t sj = static_cast<std::size_t>(w.slots[j]);
-    const Mat<Dim>& Bj = slot_basis_[sj];
-    const int rj = slot_rank_[sj];
-    const Eigen::Index cj = w.z_col[static_cast<std::size_t>(j)];
-    for (Eigen::Index i = 0; i < k; ++i) {
-      const std::size_t si = static_cast<std::size_t>(w.slots[i]);
-      const Mat<Dim>& Bi = slot_basis_[si];
-      const int ri = slot_rank_[si];
-      const Eigen::Index ci = w.z_col[static_cast<std::size_t>(i)];
-      Mat<Dim> T = Mat<Dim>::Zero();  // B_i Gr_ij in its first r_j columns
-      for (int n = 0; n < rj; ++n)
-        for (int a = 0; a < Dim; ++a) {
-          double acc = 0;
-          for (int m = 0; m < ri; ++m) acc += Bi(a, m) * Gr(ci + m, cj + n);
-          T(a, n) = acc;
-        }
-      for (int b = 0; b < Dim; ++b)
-        for (int a = 0; a < Dim; ++a) {
-          double acc = 0;
-          for (int n = 0; n < rj; ++n) acc += T(a, n) * Bj(b, n);
-          G(Dim * i + a, Dim * j + b) = acc;
-        }
-    }
-  }
+  // The group keeps Gr with the slots' directions (G_ij = B_i Gr_ij B_j^T: contact::Group).
+  group.col = w.z_col;
+  group.basis.resize(static_cast<std::size_t>(k));
+  for (Eigen::Index j = 0; j < k; ++j)
+    group.basis[static_cast<std::size_t>(j)] = slot_basis_[static_cast<std::size_t>(w.slots[j])];
   return true;
 }
 
@@ -350,10 +326,9 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     ThreadedRegion threaded_free(&timers_, ngroups > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1)
     for (std::int64_t gi = 0; gi < ngroups; ++gi) {
-      const contact::Group& group = problem_.groups[static_cast<std::size_t>(gi)];
+      const contact::Group<Dim>& group = problem_.groups[static_cast<std::size_t>(gi)];
       const auto k = group.slots.size();
-      const auto rows = static_cast<std::size_t>(group.G.rows());
-      std::vector<double> vf(rows);
+      std::vector<double> vf(Dim * k);
       for (std::size_t j = 0; j < k; ++j) {
         const auto s = static_cast<std::size_t>(group.slots[j]);
         const Vec<Dim> v0 =
@@ -362,11 +337,13 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
       }
       for (std::size_t j = 0; j < k; ++j) {
         const Vec<Dim>& P = slot_P_[static_cast<std::size_t>(group.slots[j])];
-        const double* col = group.G.data() + Dim * j * rows;
-        for (std::size_t i = 0; i < rows; ++i) {
-          double acc = col[i] * P[0];
-          for (int d = 1; d < Dim; ++d) acc += col[static_cast<std::size_t>(d) * rows + i] * P[d];
-          vf[i] -= acc;
+        for (std::size_t i = 0; i < k; ++i) {
+          const Mat<Dim> G = group.block(i, j);
+          for (int a = 0; a < Dim; ++a) {
+            double acc = G(a, 0) * P[0];
+            for (int d = 1; d < Dim; ++d) acc += G(a, d) * P[d];
+            vf[Dim * i + static_cast<std::size_t>(a)] -= acc;
+          }
         }
       }
       for (std::size_t j = 0; j < k; ++j)
@@ -423,7 +400,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   ThreadedRegion threaded_response(&timers_, ngroups > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1)
   for (std::int64_t gi = 0; gi < ngroups; ++gi) {
-    const contact::Group& group = problem_.groups[static_cast<std::size_t>(gi)];
+    const contact::Group<Dim>& group = problem_.groups[static_cast<std::size_t>(gi)];
     const std::int32_t g = slot_ref_[group.slots[0]].first;
     GrainWork& w = *work_[g];
     Eigen::VectorXd dP(w.z_col.back());  // B^T (P - P_old), slot after slot

@@ -173,7 +173,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
       const auto& sl = work_[g]->slots;
       if (sl.empty()) continue;
       const auto gi = static_cast<std::int32_t>(problem_.groups.size());
-      contact::Group group;
+      contact::Group<Dim> group;
       group.slots = sl;
       for (std::size_t j = 0; j < sl.size(); ++j) {
         problem_.slots[sl[j]].group = gi;

@@ -25,12 +25,63 @@ struct Slot {
   std::int32_t local = -1;             ///< index of the slot in its group
 };
 
-/// The linearised response of one grain at its contact slots: the velocity of slot i changes by
-/// sum_j G_ij P_j for net impulses P_j on the group's slots (G = E^T A^-1 E, A the grain's Newton
-/// matrix; the "stiffness-corrected" Delassus operator of method.md §4).
+/// The linearised response of one grain at its contact slots (the "stiffness-corrected" Delassus
+/// operator of method.md §4): the velocity of slot i changes by sum_j G_ij P_j for net impulses
+/// P_j on the group's slots, G = E^T A^-1 E with A the grain's Newton matrix. It is stored on the
+/// slots' contact directions: the impulses on slot j lie in the span of the first rank(j) columns
+/// of basis[j] (its frictionless contacts' normals, or all Dim directions), and
+/// G_ij = B_i Gr_ij B_j^T with Gr = B^T G B (docs/contact.md, "Compliance on the contact
+/// directions"). A frictionless face slot needs one number per slot pair instead of Dim^2.
+template <int Dim>
 struct Group {
   std::vector<std::int32_t> slots;  ///< slots of the group, in local order
-  Eigen::MatrixXd G;                ///< (Dim n) x (Dim n) compliance [s/kg]
+  std::vector<Mat<Dim>> basis;  ///< per slot: orthonormal directions in its first rank columns [-]
+  std::vector<Eigen::Index> col;  ///< per slot j: its first row of Gr; col[k] = Gr's size [-]
+  Eigen::MatrixXd Gr;             ///< B^T G B, the compliance on the directions [s/kg]
+
+  /// Number of directions of slot j (1 to Dim) [-].
+  int rank(std::size_t j) const { return static_cast<int>(col[j + 1] - col[j]); }
+  /// Block G_ij = B_i Gr_ij B_j^T: response of slot i's velocity to an impulse on slot j [s/kg].
+  Mat<Dim> block(std::size_t i, std::size_t j) const {
+    Mat<Dim> T = Mat<Dim>::Zero();  // B_i Gr_ij in its first rank(j) columns
+    for (int n = 0; n < rank(j); ++n)
+      for (int a = 0; a < Dim; ++a)
+        for (int m = 0; m < rank(i); ++m) T(a, n) += basis[i](a, m) * Gr(col[i] + m, col[j] + n);
+    Mat<Dim> out = Mat<Dim>::Zero();
+    for (int b = 0; b < Dim; ++b)
+      for (int a = 0; a < Dim; ++a)
+        for (int n = 0; n < rank(j); ++n) out(a, b) += T(a, n) * basis[j](b, n);
+    return out;
+  }
+  /// u_i . (G_ij w_j) = (B_i^T u_i) . Gr_ij (B_j^T w_j) for vectors u_i, w_j [s/kg].
+  double bilinear(std::size_t i, const Vec<Dim>& u, std::size_t j, const Vec<Dim>& w) const {
+    double acc = 0;
+    for (int n = 0; n < rank(j); ++n) {
+      double row = 0;
+      for (int m = 0; m < rank(i); ++m) row += u.dot(basis[i].col(m)) * Gr(col[i] + m, col[j] + n);
+      acc += row * basis[j].col(n).dot(w);
+    }
+    return acc;
+  }
+  /// Every slot with all Dim directions (B = I): Gr = G, a full (Dim k) x (Dim k) compliance
+  /// [s/kg].
+  void set_full(const Eigen::MatrixXd& G) {
+    const auto k = slots.size();
+    basis.assign(k, Mat<Dim>::Identity());
+    col.resize(k + 1);
+    for (std::size_t j = 0; j <= k; ++j) col[j] = static_cast<Eigen::Index>(Dim * j);
+    Gr = G;
+  }
+  /// G expanded to (Dim k) x (Dim k), slot after slot [s/kg].
+  Eigen::MatrixXd full() const {
+    const auto k = static_cast<Eigen::Index>(slots.size());
+    Eigen::MatrixXd G(Dim * k, Dim * k);
+    for (Eigen::Index i = 0; i < k; ++i)
+      for (Eigen::Index j = 0; j < k; ++j)
+        G.template block<Dim, Dim>(Dim * i, Dim * j) =
+            block(static_cast<std::size_t>(i), static_cast<std::size_t>(j));
+    return G;
+  }
 };
 
 /// One contact between slot A (or a wall, a = -1) and slot B; the impulse acts on B, its opposite
@@ -56,7 +107,7 @@ struct Problem {
   std::string law = "coulomb";
   std::vector<Slot<Dim>> slots;        ///< nodes taking part
   std::vector<Contact<Dim>> contacts;  ///< contacts (their impulses are the unknowns)
-  std::vector<Group> groups;           ///< compliance groups (empty: all slots lumped)
+  std::vector<Group<Dim>> groups;      ///< compliance groups (empty: all slots lumped)
 };
 
 /// The order of a Gauss-Seidel sweep over a problem's contacts: the contacts grouped by the node

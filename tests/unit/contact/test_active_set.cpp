@@ -23,10 +23,11 @@ contact::Problem<2> two_grain_problem(int n, int redundant, unsigned seed, doubl
   contact::Problem<2> p;
   p.dt = 1e-6;
   for (int g = 0; g < 2; ++g) {
-    contact::Group group;
+    contact::Group<2> group;
     Eigen::MatrixXd B(2 * n, 2 * n);
     for (Eigen::Index i = 0; i < B.size(); ++i) B.data()[i] = u(rng) - 0.5;
-    group.G = B * B.transpose() / n + 0.05 * Eigen::MatrixXd::Identity(2 * n, 2 * n);
+    const Eigen::MatrixXd G =
+        B * B.transpose() / n + 0.05 * Eigen::MatrixXd::Identity(2 * n, 2 * n);
     for (int k = 0; k < n; ++k) {
       contact::Slot<2> s;
       s.mass = 1.0;
@@ -38,6 +39,7 @@ contact::Problem<2> two_grain_problem(int n, int redundant, unsigned seed, doubl
       group.slots.push_back(static_cast<std::int32_t>(p.slots.size()));
       p.slots.push_back(s);
     }
+    group.set_full(G);
     p.groups.push_back(group);
   }
   for (int k = 0; k < n; ++k) {
@@ -126,7 +128,9 @@ TEST(ActiveSet, NormalSystemGivesTheGaussSeidelVelocities) {
       Vec<2> v = p.slots[s].v_free;
       const auto& g = p.groups[p.slots[s].group];
       for (const std::int32_t t : g.slots)
-        v += g.G.block<2, 2>(2 * p.slots[s].local, 2 * p.slots[t].local) * net[t];
+        v += g.block(static_cast<std::size_t>(p.slots[s].local),
+                     static_cast<std::size_t>(p.slots[t].local)) *
+             net[t];
       return v;
     };
     const Vec<2> va = k.a >= 0 ? velocity(k.a) : k.wall_velocity;
@@ -220,7 +224,7 @@ TEST(ActiveSet, CachedMatrixAndFactorisationGiveTheSameImpulses) {
   EXPECT_EQ((cache.W - contact::normal_system(next).W).norm(), 0.0);
   // A changed compliance with the cache cleared, as the caller does: the new W is used.
   auto stiffer = next;
-  for (auto& g : stiffer.groups) g.G *= 0.5;
+  for (auto& g : stiffer.groups) g.Gr *= 0.5;
   cache.valid = false;
   auto stiffer_scratch = stiffer;
   contact::solve_active_set(stiffer, s, &cache);

@@ -158,9 +158,10 @@ TEST(GaussSeidel, GroupsColouredOnThreadsGiveTheSameImpulsesBitForBit) {
       Eigen::MatrixXd R(m, m);
       for (Eigen::Index i = 0; i < m; ++i)
         for (Eigen::Index j = 0; j < m; ++j) R(i, j) = u(rng);
-      g.G = 0.05 * R * R.transpose() / static_cast<double>(m);
+      Eigen::MatrixXd G = 0.05 * R * R.transpose() / static_cast<double>(m);
       for (std::size_t j = 0; j < g.slots.size(); ++j)
-        g.G.block<2, 2>(2 * j, 2 * j) += Mat<2>::Identity() / p.slots[g.slots[j]].mass;
+        G.block<2, 2>(2 * j, 2 * j) += Mat<2>::Identity() / p.slots[g.slots[j]].mass;
+      g.set_full(G);
     }
     return p;
   };
@@ -242,6 +243,64 @@ TEST(GaussSeidel, ReplayedProblemGivesTheSameImpulses) {
   EXPECT_LE(std::sqrt(diff / norm), 1e-10);
 }
 
+// A compliance group on its slots' contact directions (contact::Group): one slot with a single
+// normal (a frictionless face slot), one with all Dim directions. Its blocks are B_i Gr_ij B_j^T,
+// the same after a write and a read (file v2), and a v1 file with the full matrix reads back as
+// a group with B = I and the same blocks.
+TEST(ProblemFile, GroupsOnContactDirectionsKeepTheirBlocks) {
+  contact::Problem<3> p;
+  p.dt = 1e-6;
+  for (int s = 0; s < 2; ++s) {
+    contact::Slot<3> sl;
+    sl.mass = 1.0 + s;
+    sl.group = 0;
+    sl.local = s;
+    p.slots.push_back(sl);
+  }
+  contact::Group<3> g;
+  g.slots = {0, 1};
+  const Vec<3> n = Vec<3>(1.0, -2.0, 0.5).normalized();
+  g.basis = {Mat<3>::Zero(), Mat<3>::Identity()};
+  g.basis[0].col(0) = n;
+  g.col = {0, 1, 4};
+  Eigen::MatrixXd R = Eigen::MatrixXd::Random(4, 4);
+  g.Gr = R * R.transpose() + Eigen::MatrixXd::Identity(4, 4);
+  p.groups.push_back(g);
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(6, 4);  // the slots' directions, block-diagonal
+  B.block<3, 1>(0, 0) = n;
+  B.block<3, 3>(3, 1) = Mat<3>::Identity();
+  const Eigen::MatrixXd G = B * g.Gr * B.transpose();
+  EXPECT_LE((g.full() - G).norm(), 1e-14 * G.norm());
+  EXPECT_EQ(g.rank(0), 1);
+  EXPECT_EQ(g.rank(1), 3);
+  const Vec<3> u(0.3, 0.1, -0.7), w(-0.2, 0.4, 0.9);
+  EXPECT_NEAR(g.bilinear(0, u, 1, w), u.dot(g.block(0, 1) * w), 1e-14);
+  EXPECT_NEAR(g.bilinear(1, w, 0, u), w.dot(g.block(1, 0) * u), 1e-14);
+  const auto dir = std::filesystem::temp_directory_path();
+  const auto path = (dir / "mpmcd_group_v2.txt").string();
+  contact::write_problem(p, path);
+  const auto q = contact::read_problem<3>(path);
+  ASSERT_EQ(q.groups.size(), 1u);
+  EXPECT_EQ(q.groups[0].col, g.col);
+  EXPECT_EQ((q.groups[0].Gr - g.Gr).norm(), 0.0);
+  EXPECT_EQ((q.groups[0].full() - g.full()).norm(), 0.0);
+  // A v1 file: the group's full 6 x 6 matrix after its slot line.
+  std::ofstream v1(dir / "mpmcd_group_v1.txt");
+  v1 << "# mpmcd contact problem v1\ndim 3\ndt 1e-6\nslots 2\n1 0 0 0 -1 -1 0 0\n2 0 0 0 -1 -1 0 "
+        "1\n"
+     << "contacts 0\ngroups 1\n2 0 1\n";
+  v1.precision(17);
+  for (Eigen::Index i = 0; i < 6; ++i) {
+    for (Eigen::Index j = 0; j < 6; ++j) v1 << (j ? " " : "") << G(i, j);
+    v1 << "\n";
+  }
+  v1.close();
+  const auto r = contact::read_problem<3>((dir / "mpmcd_group_v1.txt").string());
+  ASSERT_EQ(r.groups.size(), 1u);
+  EXPECT_EQ(r.groups[0].rank(0), 3);
+  EXPECT_EQ((r.groups[0].full() - G).norm(), 0.0);
+}
+
 TEST(ProblemFile, CorruptFilesAreRefusedWithAClearError) {
   const auto dir = std::filesystem::temp_directory_path();
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -253,6 +312,9 @@ TEST(ProblemFile, CorruptFilesAreRefusedWithAClearError) {
       {"dim 2\ndt 1e-3\nslots 1\n1.0 0 0 0 0 -1 -1\ncontacts 1\n-1 5 0 0 1 0 0 0 0 0 0\n",
        "slot index out of range"},
       {"dim 2\ndt 1e-3\nslots 1\n1.0 0 0 0 0 -1 -1\ncontacts 0\n", "unexpected end of file"},
+      {"# mpmcd contact problem v2\ndim 2\ndt 1e-3\nslots 1\n1.0 0 0 0 0 0 0\ncontacts 0\n"
+       "groups 1\n1 0\n3 1 0 0 1\n",
+       "expected a rank in [1, 2]"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const auto path = (dir / ("mpmcd_bad_problem_" + std::to_string(i) + ".txt")).string();
