@@ -63,9 +63,9 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
                          const Vec<Dim>& n) {
     const Vec<Dim>& ne = p.contacts[static_cast<std::size_t>(e.contact)].normal;
     if (r >= ng) return e.sign * sign * ne.dot(n) / p.slots[slot].mass;  // lumped: R = I / m
-    const Mat<Dim> G = p.groups[r].block(static_cast<std::size_t>(p.slots[e.slot].local),
-                                         static_cast<std::size_t>(p.slots[slot].local));
-    return e.sign * sign * ne.dot(G * n);
+    return e.sign * sign *
+           p.groups[r].bilinear(static_cast<std::size_t>(p.slots[e.slot].local), ne,
+                                static_cast<std::size_t>(p.slots[slot].local), n);
   };
   static const std::vector<Entry> kNone;
   const auto lists = [&](const Contact<Dim>& k) {

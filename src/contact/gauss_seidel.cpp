@@ -49,18 +49,24 @@ void respond(const Problem<Dim>& p, SlotVelocities<Dim>& v, std::int32_t s, cons
     v[s] += dP / sl.mass;
     return;
   }
-  // v_j += G_{j,s} dP for every slot j of the group, G_{j,s} = B_j Gr_js B_s^T (Group::block),
-  // against the group's contiguous velocities, each entry summed over the components of dP in
-  // order.
+  // v_j += G_{j,s} dP = B_j Gr_js (B_s^T dP) for every slot j of the group (contact::Group), on
+  // the slots' directions: one number per direction pair, against the group's contiguous
+  // velocities.
   const Group<Dim>& g = p.groups[sl.group];
   const auto s_local = static_cast<std::size_t>(sl.local);
+  const int rs = g.rank(s_local);
+  std::array<double, Dim> q{};  // B_s^T dP
+  for (int m = 0; m < rs; ++m) q[m] = g.basis[s_local].col(m).dot(dP);
+  const double* gr = g.Gr.data();
+  const auto ld = static_cast<std::size_t>(g.Gr.rows());
+  const auto cs = static_cast<std::size_t>(g.col[s_local]);
   Vec<Dim>* out = &v.value[static_cast<std::size_t>(v.first[sl.group])];
   for (std::size_t j = 0; j < g.slots.size(); ++j) {
-    const Mat<Dim> G = g.block(j, s_local);
-    for (int a = 0; a < Dim; ++a) {
-      double acc = G(a, 0) * dP[0];
-      for (int d = 1; d < Dim; ++d) acc += G(a, d) * dP[d];
-      out[j][a] += acc;
+    const auto cj = static_cast<std::size_t>(g.col[j]);
+    for (int n = 0; n < g.rank(j); ++n) {
+      double t = 0;  // (Gr_js B_s^T dP)_n
+      for (int m = 0; m < rs; ++m) t += gr[(cs + m) * ld + cj + n] * q[m];
+      out[j] += t * g.basis[j].col(n);
     }
   }
 }

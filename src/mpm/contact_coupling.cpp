@@ -335,17 +335,19 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
             slot_is_face_[s] ? slot_velocity(s) : work_[slot_ref_[s].first]->v[slot_ref_[s].second];
         for (int d = 0; d < Dim; ++d) vf[Dim * j + static_cast<std::size_t>(d)] = v0[d];
       }
+      // v_free = v - B Gr B^T P (contact::Group): the impulses on the directions, Gr times them,
+      // back to the slots' components.
+      Eigen::VectorXd pr(group.Gr.rows());
       for (std::size_t j = 0; j < k; ++j) {
         const Vec<Dim>& P = slot_P_[static_cast<std::size_t>(group.slots[j])];
-        for (std::size_t i = 0; i < k; ++i) {
-          const Mat<Dim> G = group.block(i, j);
-          for (int a = 0; a < Dim; ++a) {
-            double acc = G(a, 0) * P[0];
-            for (int d = 1; d < Dim; ++d) acc += G(a, d) * P[d];
-            vf[Dim * i + static_cast<std::size_t>(a)] -= acc;
-          }
-        }
+        for (int m = 0; m < group.rank(j); ++m) pr[group.col[j] + m] = group.basis[j].col(m).dot(P);
       }
+      const Eigen::VectorXd ur = group.Gr * pr;
+      for (std::size_t j = 0; j < k; ++j)
+        for (int m = 0; m < group.rank(j); ++m)
+          for (int d = 0; d < Dim; ++d)
+            vf[Dim * j + static_cast<std::size_t>(d)] -=
+                group.basis[j](d, m) * ur[group.col[j] + m];
       for (std::size_t j = 0; j < k; ++j)
         for (int d = 0; d < Dim; ++d)
           problem_.slots[static_cast<std::size_t>(group.slots[j])].v_free[d] =
