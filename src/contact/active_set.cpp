@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -34,10 +35,15 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
   // A contact's relative normal velocity n_c . (v_B - v_A) responds to impulses through the
   // slots it shares with other contacts: those of one compliance group (G blocks) or one lumped
   // slot (I / m). Each such resource lists its (contact, slot, sign) entries; every pair of
-  // entries adds sign_e sign_f n_e . R(slot_e, slot_f) n_f to W (method.md §4).
+  // entries adds sign_e sign_f n_e . R(slot_e, slot_f) n_f to W (method.md §4). In a group,
+  // n_e . G_ef n_f = nu_e . Gr_ef nu_f with nu = B^T n the normal on the slot's directions
+  // (contact::Group), kept in the entry with its rows of Gr.
   struct Entry {
     std::int32_t contact, slot;
     double sign;
+    int rank = 0;                  // directions of the slot (group resource), 0 if lumped
+    Eigen::Index col = 0;          // the slot's first row of Gr
+    std::array<double, Dim> nu{};  // B^T n of the contact's normal [-]
   };
   const std::size_t ng = p.groups.size();
   std::vector<std::vector<Entry>> by_resource(ng + p.slots.size());
@@ -45,27 +51,48 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
     return p.slots[s].group >= 0 ? static_cast<std::size_t>(p.slots[s].group)
                                  : ng + static_cast<std::size_t>(s);
   };
+  const auto entry = [&](std::int32_t c, std::int32_t s, double sign) {
+    Entry e{c, s, sign};
+    const Slot<Dim>& sl = p.slots[s];
+    if (sl.group < 0) return e;
+    const Group<Dim>& g = p.groups[sl.group];
+    const auto j = static_cast<std::size_t>(sl.local);
+    e.rank = g.rank(j);
+    e.col = g.col[j];
+    for (int m = 0; m < e.rank; ++m)
+      e.nu[m] = g.basis[j].col(m).dot(p.contacts[static_cast<std::size_t>(c)].normal);
+    return e;
+  };
   for (Eigen::Index c = 0; c < m; ++c) {
     const Contact<Dim>& k = p.contacts[static_cast<std::size_t>(c)];
     const Vec<Dim> va = k.a >= 0 ? p.slots[k.a].v_free : k.wall_velocity;
     sys.b[c] = k.normal.dot(p.slots[k.b].v_free - va) + k.gap / p.dt;
     sys.p[c] = k.impulse.dot(k.normal);
     if (!with_matrix) continue;
-    by_resource[resource(k.b)].push_back({static_cast<std::int32_t>(c), k.b, 1.0});
-    if (k.a >= 0) by_resource[resource(k.a)].push_back({static_cast<std::int32_t>(c), k.a, -1.0});
+    const auto ci = static_cast<std::int32_t>(c);
+    by_resource[resource(k.b)].push_back(entry(ci, k.b, 1.0));
+    if (k.a >= 0) by_resource[resource(k.a)].push_back(entry(ci, k.a, -1.0));
   }
   if (!with_matrix) return sys;
   // W column by column on the threads, straight into compressed storage: column c gathers the
   // entries of the one or two resources of its slots, whose lists are in ascending contact
   // order, merged (a contact sharing both resources with c gets both terms, added). A first
-  // pass counts each column's rows.
-  const auto value = [&](std::size_t r, const Entry& e, std::int32_t slot, double sign,
-                         const Vec<Dim>& n) {
-    const Vec<Dim>& ne = p.contacts[static_cast<std::size_t>(e.contact)].normal;
-    if (r >= ng) return e.sign * sign * ne.dot(n) / p.slots[slot].mass;  // lumped: R = I / m
-    return e.sign * sign *
-           p.groups[r].bilinear(static_cast<std::size_t>(p.slots[e.slot].local), ne,
-                                static_cast<std::size_t>(p.slots[slot].local), n);
+  // pass counts each column's rows. f is column c's own entry in the resource.
+  const auto value = [&](std::size_t r, const Entry& e, const Entry& f) {
+    if (r >= ng) {  // lumped: R = I / m
+      const Vec<Dim>& ne = p.contacts[static_cast<std::size_t>(e.contact)].normal;
+      const Vec<Dim>& nf = p.contacts[static_cast<std::size_t>(f.contact)].normal;
+      return e.sign * f.sign * ne.dot(nf) / p.slots[f.slot].mass;
+    }
+    const Eigen::MatrixXd& Gr = p.groups[r].Gr;
+    double acc = 0;
+    for (int n = 0; n < f.rank; ++n) {
+      const double* col = Gr.data() + (f.col + n) * Gr.rows() + e.col;
+      double row = 0;
+      for (int m = 0; m < e.rank; ++m) row += e.nu[m] * col[m];
+      acc += row * f.nu[n];
+    }
+    return e.sign * f.sign * acc;
   };
   static const std::vector<Entry> kNone;
   const auto lists = [&](const Contact<Dim>& k) {
@@ -99,14 +126,16 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
     const Contact<Dim>& k = p.contacts[static_cast<std::size_t>(c)];
     const auto [l1, l2] = lists(k);
     const std::size_t r1 = resource(k.b), r2 = k.a >= 0 ? resource(k.a) : 0;
+    const auto ci = static_cast<std::int32_t>(c);
+    const Entry f1 = entry(ci, k.b, 1.0), f2 = k.a >= 0 ? entry(ci, k.a, -1.0) : Entry{};
     std::size_t i = 0, j = 0;
     auto out = count[static_cast<std::size_t>(c)];
     while (i < l1->size() || j < l2->size()) {
       const std::int32_t c1 = i < l1->size() ? (*l1)[i].contact : std::numeric_limits<int>::max();
       const std::int32_t c2 = j < l2->size() ? (*l2)[j].contact : std::numeric_limits<int>::max();
       double v = 0;
-      if (c1 <= c2) v += value(r1, (*l1)[i++], k.b, 1.0, k.normal);
-      if (c2 <= c1) v += value(r2, (*l2)[j++], k.a, -1.0, k.normal);
+      if (c1 <= c2) v += value(r1, (*l1)[i++], f1);
+      if (c2 <= c1) v += value(r2, (*l2)[j++], f2);
       rows[out] = std::min(c1, c2);
       vals[out++] = v;
     }
