@@ -36,6 +36,7 @@
 #include "mpmcd/app/model_builder.hpp"
 #include "mpmcd/app/run_state.hpp"
 #include "mpmcd/app/step_controller.hpp"
+#include "mpmcd/core/allocator.hpp"
 #include "mpmcd/core/openmp_env.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "mpmcd/parallel/distribute.hpp"
@@ -232,6 +233,7 @@ bool parse_options(int argc, char** argv, Options& opt) {
 
 int main(int argc, char** argv) {
   apply_openmp_wait_policy(argv);  // as mpmcd: its spin count (may execute this again)
+  apply_allocator_policy();        // and its allocator settings
   benchmark::Initialize(&argc, argv);
   Options opt;
   if (!parse_options(argc, argv, opt)) return 2;

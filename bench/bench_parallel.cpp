@@ -23,6 +23,7 @@
 #include <iostream>
 #include <string>
 
+#include "mpmcd/core/allocator.hpp"
 #include "mpmcd/core/openmp_env.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "mpmcd/parallel/distribute.hpp"
@@ -32,6 +33,7 @@ using namespace mpmcd;
 
 int main(int argc, char** argv) {
   apply_openmp_wait_policy(argv);  // as mpmcd: its spin count (may execute this again)
+  apply_allocator_policy();        // and its allocator settings
   std::string scheme_name = "partition", csv, trace;
   int threads = 1, warmup = 50, steps = 50, cpu = 0, every = 25, mirror = 0;
   double threshold = 0;
