@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build git pkg-config
-  libeigen3-dev libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev
+  libeigen3-dev libopenblas-openmp-dev libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev libomp-dev libhdf5-dev hdf5-tools
   python3 python3-matplotlib python3-numpy python3-scipy python3-meshio
   libopenmpi-dev openmpi-bin

@@ -9,6 +9,7 @@
 #include <tuple>
 #include <vector>
 
+#include "mpmcd/core/dense_lapack.hpp"
 #include "mpmcd/contact/active_set.hpp"
 #include "solver_detail.hpp"
 
@@ -214,10 +215,8 @@ bool ImplicitSolver<Dim>::grain_compliance(std::size_t g) {
     w.resize_z(ndof, ncol, true);
     auto Z = w.Z();
     fill([&](Eigen::Index row, Eigen::Index col, double v) { Z(row, col) = v; });
-    w.chol.template triangularView<Eigen::Lower>().solveInPlace(Z);
-    Gr.setZero(ncol, ncol);
-    Gr.selfadjointView<Eigen::Lower>().rankUpdate(Z.transpose());
-    Gr.triangularView<Eigen::StrictlyUpper>() = Gr.transpose();
+    dense::lower_solve(w.chol, Z);
+    dense::gram(Z, Gr);
   } else if (w.z_forward) {
     // E B goes straight into row P_r of a row-major Y (in buffers of the thread, their capacity
     // kept), with each row's range of nonzero columns; Y = L^-1 P E B then becomes Z.
@@ -421,7 +420,7 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
     // the forward-only response.
     Eigen::VectorXd dv = w.Z() * dP;
     if (w.z_forward && w.factor_dense) {
-      w.chol.template triangularView<Eigen::Lower>().transpose().solveInPlace(dv);
+      dense::lower_transpose_solve(w.chol, dv);
     } else if (w.z_forward) {
       dv = w.ldlt.vectorD().cwiseInverse().asDiagonal() * dv;
       w.ldlt.matrixU().solveInPlace(dv);

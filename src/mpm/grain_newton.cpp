@@ -9,6 +9,7 @@
 #include <limits>
 #include <span>
 
+#include "mpmcd/core/dense_lapack.hpp"
 #include "mpmcd/mpm/grain_field.hpp"
 
 namespace mpmcd::mpm {
@@ -182,7 +183,8 @@ void assemble_tangent(GrainField<Dim>& w, const TrialState<Dim>& trial,
 namespace {
 
 // A = L L^T into w.chol (a dense grain, Settings::dense_fill): A's lower triangle copied in, then
-// Eigen's blocked in-place Cholesky. False when A is not positive definite.
+// LAPACK's blocked in-place Cholesky (core/dense_lapack.hpp). False when A is not positive
+// definite.
 template <int Dim>
 bool dense_cholesky(GrainField<Dim>& w) {
   const Eigen::Index n = w.A.rows();
@@ -192,8 +194,7 @@ bool dense_cholesky(GrainField<Dim>& w) {
     for (SpMat::InnerIterator it(w.A, c); it; ++it)
       if (it.row() >= c) w.chol(it.row(), c) = it.value();
   }
-  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(w.chol);
-  return llt.info() == Eigen::Success;
+  return dense::cholesky_in_place(w.chol);
 }
 
 }  // namespace
@@ -283,8 +284,7 @@ Eigen::VectorXd linear_solve(GrainField<Dim>& w, const Settings<Dim>& settings, 
     case LinearSolverKind::kLdlt: {
       if (!w.factor_dense) return w.ldlt.solve(rhs);
       Eigen::VectorXd x = rhs;  // L^-T L^-1 rhs
-      w.chol.template triangularView<Eigen::Lower>().solveInPlace(x);
-      w.chol.template triangularView<Eigen::Lower>().transpose().solveInPlace(x);
+      dense::cholesky_solve(w.chol, x);
       return x;
     }
     case LinearSolverKind::kLu:

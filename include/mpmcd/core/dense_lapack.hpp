@@ -1,0 +1,29 @@
+#pragma once
+/// The dense kernels of the grains factorised as dense matrices (Settings::dense_fill,
+/// docs/three_d.md): LAPACK and BLAS from OpenBLAS, whose kernels are chosen at run time for the
+/// CPU (AVX2, AVX-512) while mpmcd itself is built for portable SSE2. OpenBLAS runs on one thread
+/// here (the grains are already on the OpenMP threads), so the results do not depend on the
+/// thread count; they may differ in round-off between CPU types.
+#include <Eigen/Core>
+
+namespace mpmcd::dense {
+
+/// In-place Cholesky factorisation A = L L^T of the symmetric matrix whose lower triangle A holds
+/// (LAPACK dpotrf); L in the lower triangle, the strict upper triangle untouched. False when A is
+/// not positive definite (A's content is then unspecified).
+bool cholesky_in_place(Eigen::MatrixXd& A);
+
+/// B <- L^-1 B for the lower-triangular L of cholesky_in_place (BLAS dtrsm); B is n x m.
+void lower_solve(const Eigen::MatrixXd& L, Eigen::Ref<Eigen::MatrixXd> B);
+
+/// x <- L^-T x (BLAS dtrsv).
+void lower_transpose_solve(const Eigen::MatrixXd& L, Eigen::VectorXd& x);
+
+/// x <- (L L^T)^-1 x (LAPACK dpotrs).
+void cholesky_solve(const Eigen::MatrixXd& L, Eigen::VectorXd& x);
+
+/// G = Y^T Y, both triangles (BLAS dsyrk on the lower one, mirrored); Y is n x m, G becomes
+/// m x m.
+void gram(const Eigen::Ref<const Eigen::MatrixXd>& Y, Eigen::MatrixXd& G);
+
+}  // namespace mpmcd::dense
