@@ -16,7 +16,8 @@
 //     --stop-after 84                                      (Phi = 0.745; exits 4)
 // Checkpoints: the arguments left after Google Benchmark's, else MPMCD_COMPACTION_CHECKPOINTS
 // (paths separated by ':'); none: the benchmark is skipped with a message. Own options:
-// `--steps N` (5), `--warmup N` (1), `--threads 1,2` (thread counts). A repetition restores the
+// `--steps N` (5), `--warmup N` (1), `--threads 1,2` (thread counts), `--dense-fill F` (replaces
+// the run's [solver] dense_fill, to time the dense grain factorisations). A repetition restores the
 // checkpoint again, so repetitions time the same steps; their "min" is the best of them.
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -50,7 +51,11 @@ struct Options {
   int steps = 5;                         // timed steps per repetition
   int warmup = 1;                        // untimed steps after the restore
   std::vector<int> threads{1, 2};        // thread counts
+  double dense_fill = -1;                // replaces Settings::dense_fill when >= 0 [-]
 };
+
+// The --dense-fill value (negative: the run's own).
+double g_dense_fill = -1;
 
 // Splits `text` at `sep` (empty parts dropped).
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -126,6 +131,7 @@ void dense_steps(benchmark::State& state, const std::string& path, int threads, 
     return;
   }
   app::RestoredRun<Dim>& run = *restored;
+  if (g_dense_fill >= 0) run.settings.dense_fill = g_dense_fill;
   RestoredStepper<Dim> stepper(run);
   for (int i = 0; i < warmup; ++i)
     if (const auto st = stepper.step(); !st.converged) {
@@ -205,7 +211,8 @@ bool parse_options(int argc, char** argv, Options& opt) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
-    if ((a == "--steps" || a == "--warmup" || a == "--threads") && !has_value) {
+    if ((a == "--steps" || a == "--warmup" || a == "--threads" || a == "--dense-fill") &&
+        !has_value) {
       std::cerr << a << " needs a value\n";
       return false;
     }
@@ -213,6 +220,8 @@ bool parse_options(int argc, char** argv, Options& opt) {
       opt.steps = std::stoi(argv[++i]);
     } else if (a == "--warmup") {
       opt.warmup = std::stoi(argv[++i]);
+    } else if (a == "--dense-fill") {
+      opt.dense_fill = std::stod(argv[++i]);
     } else if (a == "--threads") {
       opt.threads.clear();
       for (const auto& t : split(argv[++i], ',')) opt.threads.push_back(std::stoi(t));
@@ -237,6 +246,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   Options opt;
   if (!parse_options(argc, argv, opt)) return 2;
+  g_dense_fill = opt.dense_fill;
   if (opt.checkpoints.empty()) {
     const char* why =
         "no checkpoint given: make one with tools/compaction_checkpoints.sh d4, then pass "

@@ -49,11 +49,11 @@ struct Settings {
   bool modified_newton = true;
   /// With kLdlt, a grain whose sparse factor L fills at least this fraction of its strict lower
   /// triangle (from the symbolic analysis) and whose system has at most dense_max_size unknowns
-  /// is factorised dense instead, as LL^T with Eigen's blocked kernels: the 3D CPDI grains
-  /// (fill 0.6-0.7) factorise 4x faster that way; 2D grains at d/8 (fill 0.4) stay sparse
-  /// (docs/three_d.md, "Dense grain factorisations"). Off by default (above 1: never); the
-  /// 3D examples set 0.5 ([solver] dense_fill): as fast as sparse in the default SSE2 build,
-  /// 21 % faster on the quick 3D run with MPMCD_NATIVE [-].
+  /// is factorised dense instead, as LL^T with OpenBLAS's kernels (core/dense_lapack.hpp): the
+  /// 3D CPDI grains (fill 0.6-0.7) factorise 4x faster that way; 2D grains at d/8 (fill 0.4)
+  /// stay sparse (docs/three_d.md, "Dense grain factorisations"). Off by default (above 1:
+  /// never); the 3D examples set 0.5 ([solver] dense_fill): the quick 3D run 168 s against
+  /// 219 s with Eigen's SSE2 kernels (2026-11-28) [-].
   double dense_fill = 2.0;
   int dense_max_size = 3000;  ///< largest system factorised dense (n^2 doubles per grain) [-]
   Vec<Dim> gravity = Vec<Dim>::Zero();  ///< body acceleration [m/s^2]
