@@ -9,8 +9,8 @@
 #include <tuple>
 #include <vector>
 
-#include "mpmcd/core/dense_lapack.hpp"
 #include "mpmcd/contact/active_set.hpp"
+#include "mpmcd/core/dense_lapack.hpp"
 #include "solver_detail.hpp"
 
 namespace mpmcd::mpm {
