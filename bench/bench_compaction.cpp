@@ -5,7 +5,8 @@
 // start and time step), then `--warmup` steps are taken untimed and `--steps` timed, as the app's
 // loop takes them (boundaries at t + dt, a failed step retried with a cut dt). Per step: wall time
 // (the benchmark's time), the share of the wall time of each solver stage (p2g, contact.detect,
-// newton.assemble, newton.solve, contact.solve, g2p), one_thread_fraction (share of the wall time
+// newton.assemble, newton.solve, contact.solve and its pivoting contact.as.pivot, g2p),
+// one_thread_fraction (share of the wall time
 // on one thread, as `mpmcd run` reports it), contacts, Gauss-Seidel sweeps, Newton iterations.
 //   tools/compaction_checkpoints.sh d4
 //   build/release/bench/bench_compaction build/compaction_checkpoints/lambda3_d4.h5
@@ -163,8 +164,8 @@ void dense_steps(benchmark::State& state, const std::string& path, int threads, 
     const auto it = totals.find(stage);
     return it == totals.end() || wall <= 0 ? 0.0 : it->second / wall;
   };
-  for (const char* stage :
-       {"p2g", "contact.detect", "newton.assemble", "newton.solve", "contact.solve", "g2p"})
+  for (const char* stage : {"p2g", "contact.detect", "newton.assemble", "newton.solve",
+                            "contact.solve", "contact.as.pivot", "g2p"})
     state.counters[std::string(stage) + "_share"] = share(stage);
   // One process: no synchronisation to wait in, the stage rows are this process's totals.
   std::vector<parallel::StageTime> rows;

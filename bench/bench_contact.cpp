@@ -5,12 +5,15 @@
 // compliance (LDLT) and the lumped (CG) Delassus operators, 1 and 2 threads, and the compliance
 // with modified Newton (Settings::modified_newton, "modified" = 1), also with CPDI shape functions
 // and affine P2G ("cpdi_affine" = 1); and one Gauss-Seidel
-// solve of a synthetic lumped problem on 1 and 2 threads (BM_GaussSeidelNodes).
+// solve of a synthetic lumped problem on 1 and 2 threads (BM_GaussSeidelNodes); the active set's
+// LDL^T on the threads (BM_TreeLdlt).
 //   ./build/release/bench/bench_contact --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
 #include "../tests/support/contact_problems.hpp"
+#include "../tests/support/sparse_matrices.hpp"
+#include "mpmcd/core/tree_ldlt.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "slice_300.hpp"
 
@@ -90,7 +93,37 @@ void BM_GaussSeidelNodes(benchmark::State& state) {
   state.counters["contacts"] = static_cast<double>(base.contacts.size());
 }
 
+// The active set's factorisation (mpmcd::TreeLdlt, docs/parallel.md) of a Delassus-like matrix
+// on an n x n grid with diagonals (tests/support/sparse_matrices.hpp; n = 72: 5,184 rows as the
+// closed contacts of the dense d/8 paper state, but a quarter of its factor's non-zeros, so the
+// ordering weighs more here): ordering, analysis and numeric LDL^T, split for `ways` workers
+// (1: Eigen's SimplicialLDLT loop) on `threads` threads. The real W_AA: bench_compaction.
+void BM_TreeLdlt(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0)), ways = static_cast<int>(state.range(1));
+  omp_set_num_threads(static_cast<int>(state.range(2)));
+  const Eigen::SparseMatrix<double> A = test_support::grid_matrix(n, n, 1e-3, 7);
+  TreeLdlt ldlt;
+  ldlt.setShift(1e-9);
+  for (auto _ : state) {
+    ldlt.compute_on_threads(A, ways, 1000);
+    benchmark::DoNotOptimize(ldlt.vectorD().data());
+  }
+  state.counters["rows"] = static_cast<double>(A.rows());
+  state.counters["L_nonzeros"] = static_cast<double>(ldlt.matrixL().nestedExpression().nonZeros());
+  state.counters["top_rows"] = static_cast<double>(ldlt.top_rows());
+  state.counters["split_speedup"] = ldlt.split_speedup();
+}
+
 }  // namespace
+
+BENCHMARK(BM_TreeLdlt)
+    ->ArgNames({"n", "ways", "threads"})
+    ->Args({72, 1, 1})
+    ->Args({72, 2, 1})
+    ->Args({72, 2, 2})
+    ->Args({72, 4, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 BENCHMARK(BM_GaussSeidelNodes)
     ->ArgNames({"threads"})

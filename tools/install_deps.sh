@@ -7,7 +7,7 @@ packages=(
   libeigen3-dev libopenblas-openmp-dev libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev libomp-dev libhdf5-dev hdf5-tools
   python3 python3-matplotlib python3-numpy python3-scipy python3-meshio
-  libopenmpi-dev openmpi-bin
+  libopenmpi-dev openmpi-bin libsuitesparse-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -148,6 +148,12 @@ namespace {
 // Contacts that enter or leave the base set before the solver factorises the active set anew
 // (the bordered solve's Schur complement is dense, of this order at most).
 constexpr int kMaxBordered = 96;
+// Ways of the split of W_AA's numeric factorisation (TreeLdlt: subtrees of the elimination tree
+// on the threads). Fixed, so that the impulses are the same bits on any thread count: the d/8
+// paper state at Phi = 0.95, 2 threads, 5 steps alternated 3 times: 371-379 ms per step against
+// 391-399 ms unsplit (pivoting 168-181 against 184-193 ms); 1 thread: 507-508 against 490-493 ms
+// (docs/parallel.md).
+constexpr int kFactorWays = 2;
 // Iterative refinement steps of a bordered solve.
 constexpr int kMaxRefinements = 4;
 
@@ -226,7 +232,7 @@ class ShiftedSolver {
     f_.Waa.resize(na, na);
     f_.Waa.setFromTriplets(t.begin(), t.end());
     f_.ldlt.setShift(f_.delta);
-    f_.ldlt.compute(f_.Waa);
+    f_.ldlt.compute_on_threads(f_.Waa, kFactorWays);
     if (f_.ldlt.info() != Eigen::Success) return false;
     const auto& L = f_.ldlt.matrixL().nestedExpression();
     f_.factor_flops = 0;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mpmcd/contact/problem.hpp"
+#include "mpmcd/core/tree_ldlt.hpp"
 
 namespace mpmcd::contact {
 
@@ -38,7 +39,7 @@ struct ShiftedFactor {
   double delta = 0;                  ///< the shift delta [s/kg]
   std::vector<std::int32_t> active;  ///< the contacts of B, ascending (empty: nothing factorised)
   Eigen::SparseMatrix<double> Waa;   ///< W restricted to B [s/kg]
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  ///< LDL^T of Waa + delta I
+  TreeLdlt ldlt;                     ///< LDL^T of Waa + delta I (numeric part on the threads)
   double factor_flops = 0;           ///< sum over L's columns of their count squared [-]
   std::vector<std::int32_t> local;   ///< per contact: its index in B, or -1 [-]
   std::vector<std::int32_t> column;  ///< per contact: its column of `solved`, or -1 [-]

@@ -1,0 +1,75 @@
+#pragma once
+/// Eigen's SimplicialLDLT with its numeric factorisation on the threads by subtrees of the
+/// elimination tree (docs/parallel.md, "The pivoting's factorisation on the threads").
+/// The up-looking factorisation computes row k of L by a sparse triangular solve over the
+/// columns of k's descendants in the elimination tree, and writes only into those columns
+/// (Davis, Direct Methods for Sparse Linear Systems, 2006, §4.7, §4.8): disjoint subtrees are
+/// independent. The tree is split into disjoint subtrees and the rows above them (the top,
+/// closed under parents). The subtrees' rows are factorised on the threads, each subtree in
+/// ascending order on one thread; then each top row in ascending order, its solve over each
+/// subtree's columns on the threads (what they subtract from the top's rows kept per subtree)
+/// and its solve over the top's columns on one thread, the subtrees' parts added in subtree
+/// order. The subtrees' rows are the bits of Eigen's factorize_preordered; a top row differs
+/// from Eigen's by the order of its sums (round-off); the split depends on the matrix only.
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace mpmcd {
+
+/// LDL^T of a symmetric sparse matrix (both triangles stored) plus a shift, with AMD ordering;
+/// solve(), matrixL(), vectorD(), permutationP() as Eigen's SimplicialLDLT.
+class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
+ public:
+  /// Orders, analyses and factorises A + shift I [A's units], the numeric part on the threads
+  /// by subtrees split for `ways` workers when A has at least `min_size` rows [-] and the split
+  /// promises a gain; info() tells success. The split depends on A and `ways` only, not on the
+  /// thread count, so the factor is the same bits on any number of threads.
+  void compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways = 2, int min_size = 1000);
+
+  /// Estimated speedup of the last numeric factorisation's split over one thread: the work
+  /// (sum over columns of c (c - 1) / 2, c their entries) divided by the largest way's subtrees'
+  /// plus the top's [-]; 1 when it was not split.
+  double split_speedup() const { return split_speedup_; }
+  /// Rows of the last factorisation's top (left on one thread) [-].
+  std::int64_t top_rows() const { return static_cast<std::int64_t>(top_.size()); }
+
+ private:
+  // One way of the split: its subtrees' rows and work arrays, and its parts of the top rows.
+  struct Bin {
+    std::vector<std::int32_t> rows;  // its subtrees' rows, each subtree ascending [-]
+    std::vector<double> y;           // the triangular solve's accumulator, zero between rows
+    std::vector<std::int32_t> pattern, tags;  // reach stack and visit marks [-]
+    /// |top| x |top|, column-major; column t, rows before t: what its columns subtract from the
+    /// top's rows (by top position) in top row t
+    std::vector<double> contributions;
+    std::vector<double> partial_d;        // per top row: what its columns subtract from D_kk
+    std::vector<std::int32_t> start_ptr;  // per top row: its range of `starts` [-]
+    std::vector<std::int32_t> starts;     // top rows where the reach leaves the subtrees [-]
+  };
+  // Chooses the top rows (top_, ascending) and the subtrees below them, dealt to `ways` bins,
+  // from the elimination tree m_parent and the column counts; leaves bins_ empty when the split
+  // would not pay.
+  void split(const Eigen::SparseMatrix<double>& ap, int ways);
+  // Row k of L and D (Eigen's factorize_preordered, LDL^T): false if D_kk = 0.
+  bool factor_row(const Eigen::SparseMatrix<double>& ap, Eigen::Index k, double* y,
+                  std::int32_t* pattern, std::int32_t* tags);
+  // Top row t's solve over bin b's columns.
+  void top_row_part(const Eigen::SparseMatrix<double>& ap, std::size_t t, std::int32_t b, Bin& bin);
+  // Top row t's solve over the top's columns and D_kk: false if D_kk = 0.
+  bool top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t, double* y,
+                    std::int32_t* pattern, std::int32_t* tags);
+
+  bool split_ = false;                 ///< the last factorisation was split
+  std::vector<Bin> bins_;              ///< the split's ways (their storage kept between calls)
+  std::vector<std::int32_t> top_;      ///< rows above the subtrees, ascending [-]
+  std::vector<std::int32_t> top_pos_;  ///< per row: its index in top_, or -1 [-]
+  std::vector<std::int32_t> owner_;    ///< per row: its bin, -1 in the top [-]
+  std::vector<int> below_;             ///< per subtree column: its entries in its subtree [-]
+  double split_speedup_ = 1.0;         ///< see split_speedup() [-]
+};
+
+}  // namespace mpmcd

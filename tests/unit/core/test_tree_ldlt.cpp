@@ -1,0 +1,112 @@
+// TreeLdlt: unsplit, Eigen's SimplicialLDLT loop on SuiteSparse AMD's order; split into subtrees
+// on the threads, the same factor to round-off and the same bits on 1 and 2 threads; a zero
+// pivot reported.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+
+#include "../../support/sparse_matrices.hpp"
+#include "mpmcd/core/tree_ldlt.hpp"
+
+namespace {
+
+using mpmcd::test_support::grid_matrix;
+
+// Factorises `A` + shift I by `tree` on `threads` threads, split for 2.
+void tree_factor(mpmcd::TreeLdlt& tree, const Eigen::SparseMatrix<double>& A, double shift,
+                 int threads) {
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  tree.setShift(shift);
+  tree.compute_on_threads(A, 2, 100);
+  omp_set_num_threads(saved);
+}
+
+void expect_same_bits(const mpmcd::TreeLdlt& a, const mpmcd::TreeLdlt& b) {
+  const auto& La = a.matrixL().nestedExpression();
+  const auto& Lb = b.matrixL().nestedExpression();
+  ASSERT_EQ(La.nonZeros(), Lb.nonZeros());
+  for (Eigen::Index k = 0; k < La.nonZeros(); ++k) {
+    ASSERT_EQ(La.innerIndexPtr()[k], Lb.innerIndexPtr()[k]) << k;
+    ASSERT_EQ(La.valuePtr()[k], Lb.valuePtr()[k]) << k;
+  }
+  ASSERT_EQ(a.vectorD(), b.vectorD());
+}
+
+TEST(TreeLdlt, OneWayIsEigensLoopOnItsOrdering) {
+  // Without a split, the numeric factorisation is Eigen's on the matrix permuted by AMD's
+  // order: Eigen's SimplicialLDLT without ordering on P A P^T gives the same bits.
+  const Eigen::SparseMatrix<double> A = grid_matrix(30, 30, 1e-2, 3);
+  mpmcd::TreeLdlt tree;
+  tree.compute_on_threads(A, 1, 100);
+  ASSERT_EQ(tree.info(), Eigen::Success);
+  EXPECT_EQ(tree.split_speedup(), 1.0);
+  EXPECT_EQ(tree.top_rows(), 0);
+  Eigen::SparseMatrix<double> permuted(A.rows(), A.cols());
+  permuted.selfadjointView<Eigen::Upper>() =
+      A.selfadjointView<Eigen::Lower>().twistedBy(tree.permutationP());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::NaturalOrdering<int>>
+      eigen(permuted);
+  ASSERT_EQ(eigen.info(), Eigen::Success);
+  EXPECT_EQ(eigen.vectorD(), tree.vectorD());
+  const auto& L1 = eigen.matrixL().nestedExpression();
+  const auto& L2 = tree.matrixL().nestedExpression();
+  ASSERT_EQ(L1.nonZeros(), L2.nonZeros());
+  for (Eigen::Index k = 0; k < L1.nonZeros(); ++k) ASSERT_EQ(L1.valuePtr()[k], L2.valuePtr()[k]);
+}
+
+TEST(TreeLdlt, SplitAgreesToRoundOffAndGivesTheSameBitsOnOneAndTwoThreads) {
+  const Eigen::SparseMatrix<double> A = grid_matrix(60, 50, 1e-3, 7);
+  const double shift = 1e-9;
+  mpmcd::TreeLdlt serial;
+  serial.setShift(shift);
+  serial.compute_on_threads(A, 1, 100);
+  ASSERT_EQ(serial.info(), Eigen::Success);
+  mpmcd::TreeLdlt two, one;
+  tree_factor(two, A, shift, 2);
+  tree_factor(one, A, shift, 1);
+  ASSERT_EQ(two.info(), Eigen::Success);
+  // The split was used: subtrees on the threads under a top of a few hundred rows.
+  EXPECT_GT(two.split_speedup(), 1.5);
+  EXPECT_GT(two.top_rows(), 0);
+  EXPECT_LT(two.top_rows(), 400);
+  expect_same_bits(two, one);
+  // The unsplit factor: the same pattern, values to round-off.
+  const auto& L1 = serial.matrixL().nestedExpression();
+  const auto& L2 = two.matrixL().nestedExpression();
+  ASSERT_EQ(L1.nonZeros(), L2.nonZeros());
+  double worst = 0;
+  for (Eigen::Index k = 0; k < L1.nonZeros(); ++k) {
+    ASSERT_EQ(L1.innerIndexPtr()[k], L2.innerIndexPtr()[k]) << k;
+    worst = std::max(worst, std::abs(L1.valuePtr()[k] - L2.valuePtr()[k]));
+  }
+  EXPECT_GT(worst, 0.0);  // the top rows sum in another order
+  EXPECT_LT(worst, 1e-10);
+  EXPECT_LT((serial.vectorD() - two.vectorD()).cwiseAbs().maxCoeff(),
+            1e-12 * serial.vectorD().cwiseAbs().maxCoeff());
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
+  const Eigen::VectorXd x = two.solve(b);
+  Eigen::SparseMatrix<double> I(A.rows(), A.cols());
+  I.setIdentity();
+  const Eigen::SparseMatrix<double> shifted = A + shift * I;
+  EXPECT_LT((shifted * x - b).norm(), 1e-9 * b.norm());
+}
+
+TEST(TreeLdlt, ZeroPivotIsReported) {
+  // A singular matrix (the grid's couplings without a diagonal term have the constant-like
+  // null vector of a signed graph Laplacian only if balanced; a zero block is singular for sure).
+  Eigen::SparseMatrix<double> A = grid_matrix(40, 40, 1e-3, 5);
+  A.coeffRef(0, 0) = 0.0;
+  for (Eigen::SparseMatrix<double>::InnerIterator it(A, 0); it; ++it) it.valueRef() = 0.0;
+  for (Eigen::Index j = 0; j < A.cols(); ++j)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it)
+      if (it.row() == 0) it.valueRef() = 0.0;
+  mpmcd::TreeLdlt tree;
+  tree_factor(tree, A, 0.0, 2);
+  EXPECT_EQ(tree.info(), Eigen::NumericalIssue);
+}
+
+}  // namespace
