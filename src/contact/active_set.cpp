@@ -156,6 +156,22 @@ constexpr int kMaxBordered = 96;
 constexpr int kFactorWays = 2;
 // Iterative refinement steps of a bordered solve.
 constexpr int kMaxRefinements = 4;
+// Contacts from which the passes over W's columns run on the threads [-].
+constexpr std::ptrdiff_t kThreadedRows = 2000;
+
+// out = q + (W + delta I) x for the symmetric W: out_c from column c (row c), on the threads.
+void shifted_product(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd& x,
+                     const Eigen::VectorXd& q, double delta, Eigen::VectorXd& out) {
+  const Eigen::Index m = W.cols();
+  out.resize(m);
+#pragma omp parallel for schedule(static) if (m > kThreadedRows)
+  for (Eigen::Index c = 0; c < m; ++c) {
+    double acc = 0;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(W, c); it; ++it)
+      acc += it.value() * x[it.row()];
+    out[c] = q[c] + acc + delta * x[c];
+  }
+}
 
 // Solves with W_AA + delta I (sparse LDL^T) kept in a ShiftedFactor: the proximal steps of one
 // solve, the pivots and (with a cache) the next solve of the same W reuse the factorisation of a
@@ -197,11 +213,17 @@ class ShiftedSolver {
     const double floor = 8 * std::numeric_limits<double>::epsilon() * r.cwiseAbs().maxCoeff();
     double last = std::numeric_limits<double>::infinity();
     for (int k = 0; k < (bordered_.empty() ? 1 : kMaxRefinements); ++k) {
-      Eigen::VectorXd res = r;  // r - (W + delta I) x on A (x = 0 off A), 0 elsewhere
-      for (const std::int32_t c : active) {
-        res[c] -= f_.delta * x[c];
+      // r - (W + delta I) x on A (x = 0 off A), 0 elsewhere; row c of W is its column c (W is
+      // symmetric), so each contact's entry is one pass over its column, on the threads.
+      Eigen::VectorXd res = Eigen::VectorXd::Zero(r.size());
+      const auto na = static_cast<std::ptrdiff_t>(active.size());
+#pragma omp parallel for schedule(static) if (na > kThreadedRows)
+      for (std::ptrdiff_t a = 0; a < na; ++a) {
+        const std::int32_t c = active[static_cast<std::size_t>(a)];
+        double acc = 0;
         for (Eigen::SparseMatrix<double>::InnerIterator it(W_, c); it; ++it)
-          if (in_active_[static_cast<std::size_t>(it.row())]) res[it.row()] -= it.value() * x[c];
+          if (in_active_[static_cast<std::size_t>(it.row())]) acc += it.value() * x[it.row()];
+        res[c] = r[c] - f_.delta * x[c] - acc;
       }
       const double norm = res.cwiseAbs().maxCoeff();
       if (!(norm < 0.5 * last) || norm <= floor) break;
@@ -414,7 +436,7 @@ bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>&
       continue;
     }
     x = z;
-    w = q + W * x + delta * x;
+    shifted_product(W, x, q, delta, w);
     const double scale = std::max(x.cwiseAbs().maxCoeff(), q_scale);
     double most = -1e-12 * scale;  // the block pivoting's feasibility tolerance
     freed = -1;
@@ -505,7 +527,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       q = sys.b - delta * p;
       // The starting active set: the contacts whose local solution (the others' impulses fixed)
       // has a positive impulse, p_c - w_c / M_cc > 0 (the semismooth-Newton rule).
-      w = q + W * p + delta * p;
+      shifted_product(W, p, q, delta, w);
       for (Eigen::Index c = 0; c < m; ++c) active[c] = p[c] - w[c] / (d[c] + delta) > 0.0;
       // Block principal pivoting (Judice & Pires 1994): flip every infeasible contact while
       // their number falls (three more tries when it does not). When it stops falling, the
@@ -521,7 +543,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
           if (active[c]) idx.push_back(static_cast<std::int32_t>(c));
         ++result.pivots;
         if (!solver.solve(idx, q, next)) break;
-        w = q + W * next + delta * next;
+        shifted_product(W, next, q, delta, w);
         double scale = next.cwiseAbs().maxCoeff();
         for (Eigen::Index c = 0; c < m; ++c) scale = std::max(scale, std::abs(q[c]) / d[c]);
         const double tol = 1e-12 * scale;
@@ -559,7 +581,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       p = next.cwiseMax(0.0);
       // Done when the violation meets the tolerance or stops falling (round-off, about 1e-14 of
       // the impulses): Gauss-Seidel's error then decides, and sweeps if it must.
-      w_p = sys.b + W * p;
+      shifted_product(W, p, sys.b, 0.0, w_p);
       const auto [worst, scale] = violation(sys, w_p, d, p);
       solved = worst <= 1e-3 * settings.tolerance * scale || worst > 0.5 * last;
       last = worst;
