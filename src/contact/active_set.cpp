@@ -245,14 +245,32 @@ class ShiftedSolver {
     f_.column.assign(m, -1);
     f_.owners.clear();
     for (Eigen::Index i = 0; i < na; ++i) f_.local[static_cast<std::size_t>(active[i])] = i;
-    std::vector<Eigen::Triplet<double>> t;
-    for (Eigen::Index i = 0; i < na; ++i)
+    // W_BB column by column straight into compressed storage, on the threads: the rows of W's
+    // column active[i] that are in B, in W's (ascending) order, which the local indices keep.
+    std::vector<int> start(static_cast<std::size_t>(na) + 1, 0);
+#pragma omp parallel for schedule(static) if (na > kThreadedRows)
+    for (Eigen::Index i = 0; i < na; ++i) {
+      int n = 0;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(W_, active[i]); it; ++it)
+        n += f_.local[static_cast<std::size_t>(it.row())] >= 0;
+      start[static_cast<std::size_t>(i) + 1] = n;
+    }
+    for (std::size_t i = 0; i < static_cast<std::size_t>(na); ++i) start[i + 1] += start[i];
+    f_.Waa.resize(na, na);
+    f_.Waa.resizeNonZeros(start.back());
+    std::copy(start.begin(), start.end(), f_.Waa.outerIndexPtr());
+    int* const rows = f_.Waa.innerIndexPtr();
+    double* const vals = f_.Waa.valuePtr();
+#pragma omp parallel for schedule(static) if (na > kThreadedRows)
+    for (Eigen::Index i = 0; i < na; ++i) {
+      int out = start[static_cast<std::size_t>(i)];
       for (Eigen::SparseMatrix<double>::InnerIterator it(W_, active[i]); it; ++it) {
         const std::int32_t j = f_.local[static_cast<std::size_t>(it.row())];
-        if (j >= 0) t.emplace_back(j, i, it.value());
+        if (j < 0) continue;
+        rows[out] = j;
+        vals[out++] = it.value();
       }
-    f_.Waa.resize(na, na);
-    f_.Waa.setFromTriplets(t.begin(), t.end());
+    }
     f_.ldlt.setShift(f_.delta);
     f_.ldlt.compute_on_threads(f_.Waa, kFactorWays);
     if (f_.ldlt.info() != Eigen::Success) return false;
