@@ -7,6 +7,7 @@
 #include <functional>
 #include <numeric>
 #include <queue>
+#include <type_traits>
 #include <utility>
 
 namespace mpmcd {
@@ -19,6 +20,33 @@ constexpr double kMinSpeedup = 1.15;
 // Rows of the top, at most (each way keeps a dense |top| x |top| block of contributions) [-].
 constexpr std::size_t kMaxTopRows = 1500;
 }  // namespace
+
+template <class Add>
+double TreeLdlt::eliminate(std::int32_t k, std::int32_t top, const std::int32_t* pattern, double* y,
+                           double d, const Add& add) {
+  // factor_row's loop: for i in pattern[top:] (the reach, in topological order), L(k, i) =
+  // y_i / D_ii appended to column i, y minus column i times y_i, D_kk minus L(k, i) y_i.
+  const auto size = static_cast<std::int32_t>(m_matrix.rows());
+  const int* Lp = m_matrix.outerIndexPtr();
+  int* Li = m_matrix.innerIndexPtr();
+  double* Lx = m_matrix.valuePtr();
+  int* count = m_nonZerosPerCol.data();
+  for (; top < size; ++top) {
+    const std::int32_t i = pattern[top];
+    double yi = y[i];
+    if constexpr (!std::is_same_v<Add, std::nullptr_t>) add(i, yi);
+    y[i] = 0.0;
+    const double l_ki = yi / m_diag[i];
+    const int p2 = Lp[i] + count[i];
+    int p = Lp[i];
+    for (; p < p2; ++p) y[Li[p]] -= Lx[p] * yi;
+    d -= l_ki * yi;
+    Li[p] = k;
+    Lx[p] = l_ki;
+    ++count[i];
+  }
+  return d;
+}
 
 void TreeLdlt::compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways, int min_size) {
   // As SimplicialCholeskyBase::compute<true> with SuiteSparse's AMD for the ordering (the
@@ -151,9 +179,6 @@ bool TreeLdlt::top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t
   // (the same sums for any thread count).
   const std::int32_t k = top_[t];
   const auto size = static_cast<std::int32_t>(ap.rows());
-  const int* Lp = m_matrix.outerIndexPtr();
-  int* Li = m_matrix.innerIndexPtr();
-  double* Lx = m_matrix.valuePtr();
   const int* parent = m_parent.data();
   int* count = m_nonZerosPerCol.data();
   std::int32_t top = size;
@@ -180,24 +205,12 @@ bool TreeLdlt::top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t
       reach(bin.starts[static_cast<std::size_t>(s)]);
     d += bin.partial_d[t];
   }
-  for (; top < size; ++top) {
-    const std::int32_t i = pattern[top];
-    double yi = y[i];
+  m_diag[k] = eliminate(k, top, pattern, y, d, [&](std::int32_t i, double& yi) {
     for (const Bin& bin : bins_)
       yi += bin.contributions[t * top_.size() +
                               static_cast<std::size_t>(top_pos_[static_cast<std::size_t>(i)])];
-    y[i] = 0.0;
-    const double l_ki = yi / m_diag[i];
-    const int p2 = Lp[i] + count[i];
-    int p = Lp[i];
-    for (; p < p2; ++p) y[Li[p]] -= Lx[p] * yi;
-    d -= l_ki * yi;
-    Li[p] = k;
-    Lx[p] = l_ki;
-    ++count[i];
-  }
-  m_diag[k] = d;
-  return d != 0.0;
+  });
+  return m_diag[k] != 0.0;
 }
 
 bool TreeLdlt::factor_row(const Eigen::SparseMatrix<double>& ap, Eigen::Index k, double* y,
@@ -205,9 +218,6 @@ bool TreeLdlt::factor_row(const Eigen::SparseMatrix<double>& ap, Eigen::Index k,
   // Eigen's SimplicialCholeskyBase::factorize_preordered<true>, the body of its loop over k
   // (Davis 2006, §4.8: row k of L by a sparse triangular solve over the elimination tree).
   const auto size = static_cast<std::int32_t>(ap.rows());
-  const int* Lp = m_matrix.outerIndexPtr();
-  int* Li = m_matrix.innerIndexPtr();
-  double* Lx = m_matrix.valuePtr();
   const int* parent = m_parent.data();
   int* count = m_nonZerosPerCol.data();
   const auto kk = static_cast<std::int32_t>(k);
@@ -227,23 +237,10 @@ bool TreeLdlt::factor_row(const Eigen::SparseMatrix<double>& ap, Eigen::Index k,
       while (len > 0) pattern[--top] = pattern[--len];
     }
   }
-  double d = y[k] * m_shiftScale + m_shiftOffset;
+  const double d = y[k] * m_shiftScale + m_shiftOffset;
   y[k] = 0.0;
-  for (; top < size; ++top) {
-    const std::int32_t i = pattern[top];
-    const double yi = y[i];
-    y[i] = 0.0;
-    const double l_ki = yi / m_diag[i];
-    const int p2 = Lp[i] + count[i];
-    int p = Lp[i];
-    for (; p < p2; ++p) y[Li[p]] -= Lx[p] * yi;
-    d -= l_ki * yi;
-    Li[p] = kk;
-    Lx[p] = l_ki;
-    ++count[i];
-  }
-  m_diag[k] = d;
-  return d != 0.0;
+  m_diag[k] = eliminate(kk, top, pattern, y, d, nullptr);
+  return m_diag[k] != 0.0;
 }
 
 void TreeLdlt::split(const Eigen::SparseMatrix<double>& ap, int ways) {

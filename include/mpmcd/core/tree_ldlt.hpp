@@ -14,6 +14,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -57,6 +58,12 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
   // Row k of L and D (Eigen's factorize_preordered, LDL^T): false if D_kk = 0.
   bool factor_row(const Eigen::SparseMatrix<double>& ap, Eigen::Index k, double* y,
                   std::int32_t* pattern, std::int32_t* tags);
+  // The numeric part of row k's solve over its reach pattern[top:] (topological order): L(k, i)
+  // appended to column i, returns D_kk from d; add(i, y_i) (a callable, or nullptr for none)
+  // adds to y_i as it is used.
+  template <class Add>
+  double eliminate(std::int32_t k, std::int32_t top, const std::int32_t* pattern, double* y,
+                   double d, const Add& add);
   // Top row t's solve over bin b's columns.
   void top_row_part(const Eigen::SparseMatrix<double>& ap, std::size_t t, std::int32_t b, Bin& bin);
   // Top row t's solve over the top's columns and D_kk: false if D_kk = 0.
