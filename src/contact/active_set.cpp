@@ -27,7 +27,7 @@ constexpr int kPreSweeps = 1;
 }  // namespace
 
 template <int Dim>
-NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
+NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix, StageTimers* timers) {
   const auto m = static_cast<Eigen::Index>(p.contacts.size());
   NormalSystem sys;
   sys.b.resize(m);
@@ -101,6 +101,7 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
   };
   std::vector<Eigen::Index> count(static_cast<std::size_t>(m) + 1, 0);
   const bool threads = ng > 1;
+  ThreadedRegion counting(timers, threads);
 #pragma omp parallel for schedule(dynamic, 64) if (threads)
   for (Eigen::Index c = 0; c < m; ++c) {
     const auto [l1, l2] = lists(p.contacts[static_cast<std::size_t>(c)]);
@@ -114,6 +115,7 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
     }
     count[static_cast<std::size_t>(c) + 1] = static_cast<Eigen::Index>(n);
   }
+  counting.done();
   for (std::size_t c = 0; c < static_cast<std::size_t>(m); ++c) count[c + 1] += count[c];
   sys.W.resize(m, m);
   sys.W.resizeNonZeros(count.back());
@@ -121,6 +123,7 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix) {
     sys.W.outerIndexPtr()[c] = static_cast<int>(count[static_cast<std::size_t>(c)]);
   int* const rows = sys.W.innerIndexPtr();
   double* const vals = sys.W.valuePtr();
+  ThreadedRegion filling(timers, threads);
 #pragma omp parallel for schedule(dynamic, 64) if (threads)
   for (Eigen::Index c = 0; c < m; ++c) {
     const Contact<Dim>& k = p.contacts[static_cast<std::size_t>(c)];
@@ -159,11 +162,14 @@ constexpr int kMaxRefinements = 4;
 // Contacts from which the passes over W's columns run on the threads [-].
 constexpr std::ptrdiff_t kThreadedRows = 2000;
 
-// out = q + (W + delta I) x for the symmetric W: out_c from column c (row c), on the threads.
+// out = q + (W + delta I) x for the symmetric W: out_c from column c (row c), on the threads
+// (their wall time to `timers`, stage kThreadedStage).
 void shifted_product(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd& x,
-                     const Eigen::VectorXd& q, double delta, Eigen::VectorXd& out) {
+                     const Eigen::VectorXd& q, double delta, Eigen::VectorXd& out,
+                     StageTimers* timers) {
   const Eigen::Index m = W.cols();
   out.resize(m);
+  ThreadedRegion region(timers, m > kThreadedRows);
 #pragma omp parallel for schedule(static) if (m > kThreadedRows)
   for (Eigen::Index c = 0; c < m; ++c) {
     double acc = 0;
@@ -178,10 +184,16 @@ void shifted_product(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd
 // base set B while the active set A differs from it by at most kMaxBordered contacts.
 class ShiftedSolver {
  public:
-  ShiftedSolver(const Eigen::SparseMatrix<double>& W, ShiftedFactor& f, double delta)
-      : W_(W), f_(f) {
+  // `timers` (may be null) gets the wall time of the threaded regions.
+  ShiftedSolver(const Eigen::SparseMatrix<double>& W, ShiftedFactor& f, double delta,
+                StageTimers* timers)
+      : W_(W), f_(f), timers_(timers) {
+    f_.ldlt.set_timers(timers);
     set_shift(delta);
   }
+
+  // The timers given at construction.
+  StageTimers* timers() const { return timers_; }
 
   // A new shift delta [s/kg]; the next solve factorises unless it is the factorised one.
   void set_shift(double delta) {
@@ -217,6 +229,7 @@ class ShiftedSolver {
       // symmetric), so each contact's entry is one pass over its column, on the threads.
       Eigen::VectorXd res = Eigen::VectorXd::Zero(r.size());
       const auto na = static_cast<std::ptrdiff_t>(active.size());
+      ThreadedRegion region(timers_, na > kThreadedRows);
 #pragma omp parallel for schedule(static) if (na > kThreadedRows)
       for (std::ptrdiff_t a = 0; a < na; ++a) {
         const std::int32_t c = active[static_cast<std::size_t>(a)];
@@ -225,6 +238,7 @@ class ShiftedSolver {
           if (in_active_[static_cast<std::size_t>(it.row())]) acc += it.value() * x[it.row()];
         res[c] = r[c] - f_.delta * x[c] - acc;
       }
+      region.done();
       const double norm = res.cwiseAbs().maxCoeff();
       if (!(norm < 0.5 * last) || norm <= floor) break;
       last = norm;
@@ -248,6 +262,7 @@ class ShiftedSolver {
     // W_BB column by column straight into compressed storage, on the threads: the rows of W's
     // column active[i] that are in B, in W's (ascending) order, which the local indices keep.
     std::vector<int> start(static_cast<std::size_t>(na) + 1, 0);
+    ThreadedRegion counting(timers_, na > kThreadedRows);
 #pragma omp parallel for schedule(static) if (na > kThreadedRows)
     for (Eigen::Index i = 0; i < na; ++i) {
       int n = 0;
@@ -255,12 +270,14 @@ class ShiftedSolver {
         n += f_.local[static_cast<std::size_t>(it.row())] >= 0;
       start[static_cast<std::size_t>(i) + 1] = n;
     }
+    counting.done();
     for (std::size_t i = 0; i < static_cast<std::size_t>(na); ++i) start[i + 1] += start[i];
     f_.Waa.resize(na, na);
     f_.Waa.resizeNonZeros(start.back());
     std::copy(start.begin(), start.end(), f_.Waa.outerIndexPtr());
     int* const rows = f_.Waa.innerIndexPtr();
     double* const vals = f_.Waa.valuePtr();
+    ThreadedRegion gathering(timers_, na > kThreadedRows);
 #pragma omp parallel for schedule(static) if (na > kThreadedRows)
     for (Eigen::Index i = 0; i < na; ++i) {
       int out = start[static_cast<std::size_t>(i)];
@@ -271,6 +288,7 @@ class ShiftedSolver {
         vals[out++] = it.value();
       }
     }
+    gathering.done();
     f_.ldlt.setShift(f_.delta);
     f_.ldlt.compute_on_threads(f_.Waa, kFactorWays);
     if (f_.ldlt.info() != Eigen::Success) return false;
@@ -319,11 +337,14 @@ class ShiftedSolver {
     const auto k = static_cast<Eigen::Index>(bordered_.size());
     if (k == 0) return true;
     const auto nb = static_cast<Eigen::Index>(f_.active.size());
-    Eigen::VectorXd c(nb);
+    // The new columns' right-hand sides c in their slots of f_.solved, then their solves, on
+    // the threads by column when there are several (each solve whole: the same bits).
+    const std::size_t first = f_.owners.size();
     for (const std::int32_t b : bordered_) {
       if (f_.column[static_cast<std::size_t>(b)] >= 0) continue;
       if (static_cast<Eigen::Index>(f_.owners.size()) == f_.solved.cols())
         f_.solved.conservativeResize(nb, 2 * f_.solved.cols());
+      auto c = f_.solved.col(static_cast<Eigen::Index>(f_.owners.size()));
       c.setZero();
       if (f_.local[static_cast<std::size_t>(b)] >= 0) {
         c[f_.local[static_cast<std::size_t>(b)]] = 1.0;
@@ -334,9 +355,18 @@ class ShiftedSolver {
         }
       }
       f_.column[static_cast<std::size_t>(b)] = static_cast<std::int32_t>(f_.owners.size());
-      f_.solved.col(static_cast<Eigen::Index>(f_.owners.size())) = f_.ldlt.solve(c);
       f_.owners.push_back(b);
     }
+    const auto fresh = static_cast<std::ptrdiff_t>(f_.owners.size() - first);
+    ThreadedRegion columns(timers_, fresh > 1);
+#pragma omp parallel for schedule(dynamic) if (fresh > 1)
+    for (std::ptrdiff_t i = 0; i < fresh; ++i) {
+      auto col = f_.solved.col(static_cast<Eigen::Index>(first) + i);
+      Eigen::VectorXd c = col;
+      f_.ldlt.solve_in_place(c);
+      col = c;
+    }
+    columns.done();
     Eigen::MatrixXd S(k, k);
     for (Eigen::Index j = 0; j < k; ++j) {
       const auto z = f_.solved.col(f_.column[static_cast<std::size_t>(bordered_[j])]);
@@ -367,10 +397,10 @@ class ShiftedSolver {
   // x_B = u - (W_BB + delta I)^-1 C y and x_N = y (x_R = 0: y's R part is their multiplier).
   Eigen::VectorXd apply(const Eigen::VectorXd& r) const {
     const auto nb = static_cast<Eigen::Index>(f_.active.size());
-    Eigen::VectorXd rb(nb);
+    Eigen::VectorXd u(nb);
     for (Eigen::Index i = 0; i < nb; ++i)
-      rb[i] = in_active_[static_cast<std::size_t>(f_.active[i])] ? r[f_.active[i]] : 0.0;
-    Eigen::VectorXd u = f_.ldlt.solve(rb);
+      u[i] = in_active_[static_cast<std::size_t>(f_.active[i])] ? r[f_.active[i]] : 0.0;
+    f_.ldlt.solve_in_place(u);
     Eigen::VectorXd x = Eigen::VectorXd::Zero(r.size());
     const auto k = static_cast<Eigen::Index>(bordered_.size());
     if (k > 0) {
@@ -378,10 +408,21 @@ class ShiftedSolver {
       for (Eigen::Index i = 0; i < k; ++i)
         rhs[i] = (static_cast<std::size_t>(i) < n_entered_ ? r[bordered_[i]] : 0.0) - dot_c(i, u);
       const Eigen::VectorXd y = schur_.solve(rhs);
-      for (Eigen::Index j = 0; j < k; ++j) {
-        u -= y[j] * f_.solved.col(f_.column[static_cast<std::size_t>(bordered_[j])]);
-        if (static_cast<std::size_t>(j) < n_entered_) x[bordered_[j]] = y[j];
+      // u minus the solved columns times y, by blocks of rows on the threads (each entry's
+      // sum over the columns in their order: the same bits on any thread count).
+      const int blocks = nb > kThreadedRows ? 2 : 1;
+      ThreadedRegion region(timers_, blocks > 1);
+#pragma omp parallel for schedule(static) if (blocks > 1)
+      for (int part = 0; part < blocks; ++part) {
+        const Eigen::Index lo = nb * part / blocks, len = nb * (part + 1) / blocks - lo;
+        for (Eigen::Index j = 0; j < k; ++j)
+          u.segment(lo, len) -=
+              y[j] *
+              f_.solved.col(f_.column[static_cast<std::size_t>(bordered_[j])]).segment(lo, len);
       }
+      region.done();
+      for (std::size_t j = 0; j < n_entered_; ++j)
+        x[bordered_[j]] = y[static_cast<Eigen::Index>(j)];
     }
     for (Eigen::Index i = 0; i < nb; ++i)
       if (in_active_[static_cast<std::size_t>(f_.active[i])]) x[f_.active[i]] = u[i];
@@ -390,6 +431,7 @@ class ShiftedSolver {
 
   const Eigen::SparseMatrix<double>& W_;
   ShiftedFactor& f_;
+  StageTimers* timers_;                 // see the constructor
   std::vector<std::int32_t> bordered_;  // N (entered), then R (left)
   std::size_t n_entered_ = 0;
   std::vector<char> in_active_;  // per contact: in the active set of this solve
@@ -454,7 +496,7 @@ bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>&
       continue;
     }
     x = z;
-    shifted_product(W, x, q, delta, w);
+    shifted_product(W, x, q, delta, w, solver.timers());
     const double scale = std::max(x.cwiseAbs().maxCoeff(), q_scale);
     double most = -1e-12 * scale;  // the block pivoting's feasibility tolerance
     freed = -1;
@@ -512,7 +554,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       }
     }
     ScopedStage assemble(settings.timers, "contact.as.assemble");
-    NormalSystem sys = normal_system(problem, !reuse);
+    NormalSystem sys = normal_system(problem, !reuse, settings.timers);
     ActiveSetCache local;
     ActiveSetCache& kept = cache ? *cache : local;
     if (!reuse) {
@@ -534,7 +576,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
     // grows 100-fold (to 1e-6) whenever the pivoting cycles on an ill-conditioned W_AA.
     const double w_max = d.maxCoeff();
     double delta = 1e-12 * w_max;
-    ShiftedSolver solver(W, kept.factor, delta);
+    ShiftedSolver solver(W, kept.factor, delta, settings.timers);
     Eigen::VectorXd p = sys.p.cwiseMax(0.0), q, w, next(m);
     Eigen::VectorXd w_p;  // b + W p at the last accepted impulses p [m/s]
     std::vector<char> active(static_cast<std::size_t>(m));
@@ -545,7 +587,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       q = sys.b - delta * p;
       // The starting active set: the contacts whose local solution (the others' impulses fixed)
       // has a positive impulse, p_c - w_c / M_cc > 0 (the semismooth-Newton rule).
-      shifted_product(W, p, q, delta, w);
+      shifted_product(W, p, q, delta, w, settings.timers);
       for (Eigen::Index c = 0; c < m; ++c) active[c] = p[c] - w[c] / (d[c] + delta) > 0.0;
       // Block principal pivoting (Judice & Pires 1994): flip every infeasible contact while
       // their number falls (three more tries when it does not). When it stops falling, the
@@ -561,7 +603,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
           if (active[c]) idx.push_back(static_cast<std::int32_t>(c));
         ++result.pivots;
         if (!solver.solve(idx, q, next)) break;
-        shifted_product(W, next, q, delta, w);
+        shifted_product(W, next, q, delta, w, settings.timers);
         double scale = next.cwiseAbs().maxCoeff();
         for (Eigen::Index c = 0; c < m; ++c) scale = std::max(scale, std::abs(q[c]) / d[c]);
         const double tol = 1e-12 * scale;
@@ -599,7 +641,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       p = next.cwiseMax(0.0);
       // Done when the violation meets the tolerance or stops falling (round-off, about 1e-14 of
       // the impulses): Gauss-Seidel's error then decides, and sweeps if it must.
-      shifted_product(W, p, sys.b, 0.0, w_p);
+      shifted_product(W, p, sys.b, 0.0, w_p, settings.timers);
       const auto [worst, scale] = violation(sys, w_p, d, p);
       solved = worst <= 1e-3 * settings.tolerance * scale || worst > 0.5 * last;
       last = worst;
@@ -629,8 +671,8 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
   return result;
 }
 
-#define MPMCD_INSTANTIATE(D)                                       \
-  template NormalSystem normal_system<D>(const Problem<D>&, bool); \
+#define MPMCD_INSTANTIATE(D)                                                     \
+  template NormalSystem normal_system<D>(const Problem<D>&, bool, StageTimers*); \
   template GsResult solve_active_set<D>(Problem<D>&, const GsSettings&, ActiveSetCache*);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)

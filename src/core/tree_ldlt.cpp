@@ -83,6 +83,7 @@ void TreeLdlt::compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways
   const int threads =
       omp_in_parallel() ? 1 : std::min(omp_get_max_threads(), static_cast<int>(bins_.size()));
   // Each way (bin) on one thread: its subtrees' rows, then its parts of the top rows.
+  ThreadedRegion region(timers_, threads > 1);
 #pragma omp parallel for schedule(static, 1) num_threads(threads)
   for (std::size_t b = 0; b < bins_.size(); ++b) {
     Bin& bin = bins_[b];
@@ -111,6 +112,7 @@ void TreeLdlt::compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways
       below_[static_cast<std::size_t>(k)] = m_nonZerosPerCol[k];
     for (std::size_t t = 0; t < nt; ++t) top_row_part(ap, t, static_cast<std::int32_t>(b), bin);
   }
+  region.done();
   // The top rows on one thread, with the ways' parts.
   if (ok) {
     std::vector<double> y(nu, 0.0);
@@ -120,6 +122,64 @@ void TreeLdlt::compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways
   }
   m_info = ok ? Eigen::Success : Eigen::NumericalIssue;
   m_factorizationIsOk = true;
+}
+
+void TreeLdlt::solve_in_place(Eigen::VectorXd& b) const {
+  if (!split_) {
+    b = solve(b);
+    return;
+  }
+  // Eigen's SimplicialCholeskyBase::_solve_impl: x = P b, L x = x (unit lower), x = D^-1 x,
+  // L^T x = x, b = P^-1 x; the two substitutions by subtrees (see the declaration).
+  Eigen::VectorXd x = m_P * b;
+  const int* Lp = m_matrix.outerIndexPtr();
+  const int* Li = m_matrix.innerIndexPtr();
+  const double* Lx = m_matrix.valuePtr();
+  const int* count = m_nonZerosPerCol.data();
+  const std::size_t nt = top_.size(), nb = bins_.size();
+  const int threads = omp_in_parallel() ? 1 : std::min(omp_get_max_threads(), static_cast<int>(nb));
+  // Forward, each way's columns: its rows' entries (the first below_ of a column) in x, the
+  // top's in its own accumulator (by top position).
+  std::vector<double> acc(nb * nt, 0.0);
+  ThreadedRegion forward(timers_, threads > 1);
+#pragma omp parallel for schedule(static, 1) num_threads(threads)
+  for (std::size_t w = 0; w < nb; ++w) {
+    double* a = acc.data() + w * nt;
+    for (const std::int32_t k : bins_[w].rows) {
+      const double xk = x[k];
+      if (xk == 0.0) continue;
+      const int p1 = Lp[k] + below_[static_cast<std::size_t>(k)], p2 = Lp[k] + count[k];
+      int p = Lp[k];
+      for (; p < p1; ++p) x[Li[p]] -= Lx[p] * xk;
+      for (; p < p2; ++p) a[top_pos_[static_cast<std::size_t>(Li[p])]] -= Lx[p] * xk;
+    }
+  }
+  forward.done();
+  // The top's columns (they reach top rows only), each row with the ways' parts first.
+  for (std::size_t t = 0; t < nt; ++t) {
+    const std::int32_t k = top_[t];
+    double xk = x[k];
+    for (std::size_t w = 0; w < nb; ++w) xk += acc[w * nt + t];
+    x[k] = xk;
+    if (xk == 0.0) continue;
+    for (int p = Lp[k]; p < Lp[k] + count[k]; ++p) x[Li[p]] -= Lx[p] * xk;
+  }
+  // Backward with the diagonal: row k of L^T x = D^-1 x reads its ancestors' entries, so the
+  // top (descending) first, then each way's subtrees (descending) on the threads.
+  const double* d = m_diag.data();
+  const auto back = [&](std::int32_t k) {
+    double xk = x[k] * (1.0 / d[k]);
+    for (int p = Lp[k]; p < Lp[k] + count[k]; ++p) xk -= Lx[p] * x[Li[p]];
+    x[k] = xk;
+  };
+  for (std::size_t t = nt; t-- > 0;) back(top_[t]);
+  {
+    ThreadedRegion backward(timers_, threads > 1);
+#pragma omp parallel for schedule(static, 1) num_threads(threads)
+    for (std::size_t w = 0; w < nb; ++w)
+      for (auto it = bins_[w].rows.rbegin(); it != bins_[w].rows.rend(); ++it) back(*it);
+  }
+  b = m_Pinv * x;
 }
 
 void TreeLdlt::top_row_part(const Eigen::SparseMatrix<double>& ap, std::size_t t, std::int32_t b,

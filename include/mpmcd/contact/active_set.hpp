@@ -27,9 +27,10 @@ struct NormalSystem {
 };
 
 /// The normal system of a problem (every contact's friction ignored); without `with_matrix`,
-/// only b and p (W left empty).
+/// only b and p (W left empty). `timers` (may be null) gets its threaded regions' wall time [s].
 template <int Dim>
-NormalSystem normal_system(const Problem<Dim>& problem, bool with_matrix = true);
+NormalSystem normal_system(const Problem<Dim>& problem, bool with_matrix = true,
+                           StageTimers* timers = nullptr);
 
 /// A sparse LDL^T of W_BB + delta I for one base set B of contacts, and what the pivoting's
 /// solves on other active sets A near B reuse: A differs from B by the contacts N that entered

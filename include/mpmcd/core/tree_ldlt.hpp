@@ -14,10 +14,12 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+
 #include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
+#include "mpmcd/core/timer.hpp"
 
 namespace mpmcd {
 
@@ -30,6 +32,18 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
   /// promises a gain; info() tells success. The split depends on A and `ways` only, not on the
   /// thread count, so the factor is the same bits on any number of threads.
   void compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways = 2, int min_size = 1000);
+
+  /// b := (A + shift I)^-1 b [b's units over A's], in place. After a split factorisation the
+  /// forward substitution runs by the same subtrees on the threads, then the top rows, each
+  /// way's part of them added in way order; the backward one the top rows first, then the
+  /// subtrees on the threads (Davis 2006, §4.7: column j of L only reaches j's ancestors). The
+  /// same bits on any thread count and inside a parallel region (one thread); to round-off
+  /// Eigen's solve() (the top rows' sums in another order). Unsplit: Eigen's solve().
+  void solve_in_place(Eigen::VectorXd& b) const;
+
+  /// Timers whose stage kThreadedStage gets the wall time of the threaded regions [s] (null:
+  /// none); not owned.
+  void set_timers(StageTimers* timers) { timers_ = timers; }
 
   /// Estimated speedup of the last numeric factorisation's split over one thread: the work
   /// (sum over columns of c (c - 1) / 2, c their entries) divided by the largest way's subtrees'
@@ -77,6 +91,7 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
   std::vector<std::int32_t> owner_;    ///< per row: its bin, -1 in the top [-]
   std::vector<int> below_;             ///< per subtree column: its entries in its subtree [-]
   double split_speedup_ = 1.0;         ///< see split_speedup() [-]
+  StageTimers* timers_ = nullptr;      ///< see set_timers()
 };
 
 }  // namespace mpmcd

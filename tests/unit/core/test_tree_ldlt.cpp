@@ -1,6 +1,6 @@
 // TreeLdlt: unsplit, Eigen's SimplicialLDLT loop on SuiteSparse AMD's order; split into subtrees
-// on the threads, the same factor to round-off and the same bits on 1 and 2 threads; a zero
-// pivot reported.
+// on the threads, the same factor to round-off and the same bits on 1 and 2 threads; its
+// substitutions on the threads; a zero pivot reported.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -93,6 +93,48 @@ TEST(TreeLdlt, SplitAgreesToRoundOffAndGivesTheSameBitsOnOneAndTwoThreads) {
   I.setIdentity();
   const Eigen::SparseMatrix<double> shifted = A + shift * I;
   EXPECT_LT((shifted * x - b).norm(), 1e-9 * b.norm());
+}
+
+TEST(TreeLdlt, SubstitutionsOnTheThreadsAgreeWithEigensSolveAndGiveTheSameBits) {
+  // solve_in_place after a split factorisation: the subtrees' substitutions on the threads, the
+  // top's on one; against Eigen's solve() with the same factor to round-off, the same bits on
+  // 1 and 2 threads and inside a parallel region, and the residual of A + shift I.
+  const Eigen::SparseMatrix<double> A = grid_matrix(60, 50, 1e-3, 7);
+  const double shift = 1e-9;
+  mpmcd::TreeLdlt tree;
+  tree_factor(tree, A, shift, 2);
+  ASSERT_GT(tree.top_rows(), 0);
+  Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
+  b[7] = 0.0;  // a zero entry: the forward substitution skips its column
+  const Eigen::VectorXd eigen = tree.solve(b);
+  const int saved = omp_get_max_threads();
+  Eigen::VectorXd two = b, one = b, nested = b;
+  omp_set_num_threads(2);
+  tree.solve_in_place(two);
+#pragma omp parallel num_threads(2)
+  {
+#pragma omp single
+    tree.solve_in_place(nested);
+  }
+  omp_set_num_threads(1);
+  tree.solve_in_place(one);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(two, one);
+  EXPECT_EQ(two, nested);
+  const double scale = eigen.cwiseAbs().maxCoeff();
+  EXPECT_GT((two - eigen).cwiseAbs().maxCoeff(), 0.0);  // the top rows sum in another order
+  EXPECT_LT((two - eigen).cwiseAbs().maxCoeff(), 1e-11 * scale);
+  Eigen::SparseMatrix<double> I(A.rows(), A.cols());
+  I.setIdentity();
+  const Eigen::SparseMatrix<double> shifted = A + shift * I;
+  EXPECT_LT((shifted * two - b).norm(), 1e-9 * b.norm());
+  // Unsplit, it is Eigen's solve().
+  mpmcd::TreeLdlt whole;
+  whole.setShift(shift);
+  whole.compute_on_threads(A, 1, 100);
+  Eigen::VectorXd w = b;
+  whole.solve_in_place(w);
+  EXPECT_EQ(w, whole.solve(b));
 }
 
 TEST(TreeLdlt, ZeroPivotIsReported) {
