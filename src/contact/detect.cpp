@@ -93,6 +93,7 @@ double Detector<Dim>::detect(const DetectInput<Dim>& in, Problem<Dim>& problem,
     point_reach_.resize(pts.x.size());
     if (cs.grain_faces) point_dinv_.resize(pts.x.size());
     const auto nl = static_cast<std::int64_t>(in.local.size());
+    const ThreadedRegion threaded_reach(in.timers, nl > 1);
 #pragma omp parallel for schedule(dynamic, 4) if (nl > 1)
     for (std::int64_t i = 0; i < nl; ++i) {
       const FieldView<Dim>& gr = fields[in.local[static_cast<std::size_t>(i)]];

@@ -83,8 +83,10 @@ bool threaded_problem(const Problem<Dim>& p) {
   return p.contacts.size() > (p.groups.empty() ? kThreadedContacts : kThreadedGroupContacts);
 }
 
+// The slots' velocities v_free + response to the current impulses, the groups on the threads if
+// `threads` (their wall time to `timers`, stage kThreadedStage; null: none).
 template <int Dim>
-SlotVelocities<Dim> slot_velocities(const Problem<Dim>& p, bool threads) {
+SlotVelocities<Dim> slot_velocities(const Problem<Dim>& p, bool threads, StageTimers* timers) {
   SlotVelocities<Dim> v;
   const auto nslots = static_cast<std::int32_t>(p.slots.size());
   v.value.resize(p.slots.size());
@@ -102,10 +104,12 @@ SlotVelocities<Dim> slot_velocities(const Problem<Dim>& p, bool threads) {
   // A group's impulses move its own slots only: the groups on the threads, each summing its
   // slots' responses in its slot order (the same bits for any thread count).
   const auto ng = static_cast<std::int64_t>(p.groups.size());
+  ThreadedRegion region(timers, threads);
 #pragma omp parallel for schedule(dynamic, 4) if (threads)
   for (std::int64_t g = 0; g < ng; ++g)
     for (const std::int32_t s : p.groups[g].slots)
       if (net[s] != Vec<Dim>::Zero()) respond(p, v, s, net[s]);
+  region.done();
   for (std::size_t s = 0; s < p.slots.size(); ++s)
     if (p.slots[s].group < 0 && net[s] != Vec<Dim>::Zero())
       respond(p, v, static_cast<std::int32_t>(s), net[s]);
@@ -379,7 +383,7 @@ void sweep(Problem<Dim>& p, SlotVelocities<Dim>& v, const SweepOrder& runs, Stag
 template <int Dim>
 void error_sums(const Problem<Dim>& p, double& num, double& den, StageTimers* timers, bool threads,
                 LocalSolver<Dim> local) {
-  const auto v = slot_velocities(p, threads);
+  const auto v = slot_velocities(p, threads, timers);
   // Each contact's terms on the threads, summed in contact order (the same bits for any count).
   const auto n = static_cast<std::int64_t>(p.contacts.size());
   std::vector<double> tn(static_cast<std::size_t>(n)), td(static_cast<std::size_t>(n));
@@ -432,7 +436,7 @@ GsResult gauss_seidel(Problem<Dim>& p, const GsSettings& settings, const ErrorRe
     r.converged = true;
     return r;
   }
-  auto v = slot_velocities(p, can_thread);
+  auto v = slot_velocities(p, can_thread, settings.timers);
   const SweepOrder own = settings.order ? SweepOrder{} : sweep_order(p);
   const SweepOrder& runs = settings.order ? *settings.order : own;
   const double work = static_cast<double>(p.contacts.size());
