@@ -130,6 +130,13 @@ def dense_mode():
             fr = amdahl[grid]
             ax.plot(xs, [1 / (fr + (1 - fr) / p) for p in xs], "--",
                     label=f"{grid}: Amdahl, f = {100 * fr:.1f} %")
+        # Issue 16's references: its target f = 2 % (12x at 16 processes) and the whole paper
+        # case as it was measured when the issue was filed (main at 6da5b8f, 16 threads of a
+        # 16-core Xeon: 2.9x).
+        ax.plot(xs, [1 / (0.02 + 0.98 / p) for p in xs], ":", color="gray",
+                label="issue 16 target: Amdahl, f = 2 %")
+        ax.plot([16], [2.9], "x", color="black", ms=8,
+                label="paper case at 6da5b8f, 16 threads (issue 16)")
         finish_speedup_plot(fig, ax, "threads P", "paper compaction, dense state (cf. paper Fig. 2)",
                             "dense_scaling.png")
     except ImportError:
