@@ -131,7 +131,7 @@ void TreeLdlt::solve_in_place(Eigen::VectorXd& b) const {
   }
   // Eigen's SimplicialCholeskyBase::_solve_impl: x = P b, L x = x (unit lower), x = D^-1 x,
   // L^T x = x, b = P^-1 x; the two substitutions by subtrees (see the declaration).
-  Eigen::VectorXd x = m_P * b;
+  Eigen::VectorXd x = m_P.size() > 0 ? Eigen::VectorXd(m_P * b) : b;
   const int* Lp = m_matrix.outerIndexPtr();
   const int* Li = m_matrix.innerIndexPtr();
   const double* Lx = m_matrix.valuePtr();
@@ -179,7 +179,11 @@ void TreeLdlt::solve_in_place(Eigen::VectorXd& b) const {
     for (std::size_t w = 0; w < nb; ++w)
       for (auto it = bins_[w].rows.rbegin(); it != bins_[w].rows.rend(); ++it) back(*it);
   }
-  b = m_Pinv * x;
+  if (m_Pinv.size() > 0) {
+    b = m_Pinv * x;
+  } else {
+    b = x;
+  }
 }
 
 void TreeLdlt::top_row_part(const Eigen::SparseMatrix<double>& ap, std::size_t t, std::int32_t b,
