@@ -199,6 +199,20 @@ double Detector<Dim>::detect(const DetectInput<Dim>& in, Problem<Dim>& problem,
       }
     }
   }
+  // Face walls: each (wall, grain) pair's faces near the wall on the threads (a pure function of
+  // the points), then the contacts in the serial order (wall, grain, column, face) below.
+  std::vector<std::vector<WallFace>> wall_face_lists(cs.wall_points ? nw * nlocal : 0);
+  if (cs.wall_points && nw > 0) {
+    const auto npairs = static_cast<std::int64_t>(nw * nlocal);
+    const ThreadedRegion threaded_faces(in.timers, npairs > 1);
+#pragma omp parallel for schedule(dynamic, 4) if (npairs > 1)
+    for (std::int64_t k = 0; k < npairs; ++k) {
+      const std::size_t wi = static_cast<std::size_t>(k) / nlocal;
+      const std::size_t g = in.local[static_cast<std::size_t>(k) % nlocal];
+      wall_face_lists[static_cast<std::size_t>(k)] = wall_faces<Dim>(
+          cs.walls[wi], in.time, pts, fields[g].begin, fields[g].end, cs.wall_range * h, h);
+    }
+  }
   for (std::size_t wi = 0; wi < cs.walls.size(); ++wi) {
     const walls::Wall<Dim>& wall = cs.walls[wi];
     for (std::size_t li = 0; li < nlocal; ++li) {
@@ -215,8 +229,7 @@ double Detector<Dim>::detect(const DetectInput<Dim>& in, Problem<Dim>& problem,
         // per face"); the pivoting tolerates the redundancy. Gauss-Seidel stalls on redundant
         // constraints, so with it the faces of a column make one contact on their mean velocity.
         const bool per_face = cs.active_set;
-        const std::vector<WallFace> faces = wall_faces<Dim>(wall, in.time, pts, fields[g].begin,
-                                                            fields[g].end, cs.wall_range * h, h);
+        const std::vector<WallFace>& faces = wall_face_lists[wi * nlocal + li];
         items += static_cast<double>(faces.size());
         // One contact on the faces of `face_pts`; `key_of` gives its warm-start key (negative: not
         // a node).
