@@ -59,8 +59,10 @@ def load(path):
 def eps_at(run, phi):
     """eps at the first crossing of Phi = phi (linear in Phi), or nan if never reached."""
     p, e = run["phi"], run["eps"]
+    if p[0] >= phi:
+        return e[0]
     for i in range(1, len(p)):
-        if p[i] >= phi > p[i - 1] or (i == 1 and p[0] >= phi):
+        if p[i] >= phi > p[i - 1]:
             if p[i] == p[i - 1]:
                 return e[i]
             t = (phi - p[i - 1]) / (p[i] - p[i - 1])
