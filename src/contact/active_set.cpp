@@ -159,6 +159,8 @@ constexpr int kMaxBordered = 96;
 constexpr int kFactorWays = 2;
 // Iterative refinement steps of a bordered solve.
 constexpr int kMaxRefinements = 4;
+// Projected Gauss-Seidel sweeps on W before the first active set of a new W (sweep_on_w).
+constexpr int kWSweeps = 20;
 // Contacts from which the passes over W's columns run on the threads [-].
 constexpr std::ptrdiff_t kThreadedRows = 2000;
 
@@ -176,6 +178,34 @@ void shifted_product(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd
     for (Eigen::SparseMatrix<double>::InnerIterator it(W, c); it; ++it)
       acc += it.value() * x[it.row()];
     out[c] = q[c] + acc + delta * x[c];
+  }
+}
+
+// Projected Gauss-Seidel sweeps on W for the shifted problem min 1/2 x.(W + delta I) x + q.x,
+// x >= 0 (each contact's local solution x_c = max(0, x_c - w_c / (W_cc + delta)), w = q +
+// (W + delta I) x, method.md §4), from x. The contacts are swept in two fixed halves at once, each
+// in order with the other half's values of the previous sweep (block Jacobi between the halves),
+// so the answer is the same bits on any thread count. On the threads from kThreadedRows contacts.
+void sweep_on_w(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd& q,
+                const Eigen::VectorXd& d, double delta, Eigen::VectorXd& x, int sweeps,
+                StageTimers* timers) {
+  const Eigen::Index m = W.cols(), half = m / 2;
+  Eigen::VectorXd before(m);
+  for (int k = 0; k < sweeps; ++k) {
+    before = x;
+    ThreadedRegion region(timers, m > kThreadedRows);
+#pragma omp parallel for schedule(static, 1) if (m > kThreadedRows)
+    for (int part = 0; part < 2; ++part) {
+      const Eigen::Index lo = part == 0 ? 0 : half, hi = part == 0 ? half : m;
+      for (Eigen::Index c = lo; c < hi; ++c) {
+        double acc = q[c] + delta * x[c];
+        for (Eigen::SparseMatrix<double>::InnerIterator it(W, c); it; ++it) {
+          const Eigen::Index r = it.row();
+          acc += it.value() * (r >= lo && r < hi ? x[r] : before[r]);
+        }
+        x[c] = std::max(0.0, x[c] - acc / (d[c] + delta));
+      }
+    }
   }
 }
 
@@ -203,9 +233,10 @@ class ShiftedSolver {
 
   // p_A = (W_AA + delta I)^-1 r_A with r = -q on the contacts `active` (ascending), 0
   // elsewhere; false when a factorisation fails.
-  bool solve(const std::vector<std::int32_t>& active, const Eigen::VectorXd& q,
-             Eigen::VectorXd& p) {
+  bool solve(const std::vector<std::int32_t>& active, const Eigen::VectorXd& q, Eigen::VectorXd& p,
+             bool refined = true) {
     p.setZero();
+    active_ = active;
     if (active.empty()) return true;
     if (f_.active.empty() || !border(active) || !cheaper_bordered()) {
       if (!factorise(active)) return false;
@@ -214,39 +245,43 @@ class ShiftedSolver {
     if (!prepare()) {
       if (!factorise(active) || !border(active) || !prepare()) return false;
     }
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(q.size());
-    for (const std::int32_t c : active) r[c] = -q[c];
-    Eigen::VectorXd x = apply(r);
-    // Iterative refinement against W_AA + delta I: one step after a fresh factorisation, up to
-    // kMaxRefinements while the residual halves after a bordered solve, whose Schur complement
-    // loses digits on the nearly redundant contacts (with one step the two-grain block test
-    // stalled at impulse changes of 4e-12 between Newton iterations).
+    r_ = Eigen::VectorXd::Zero(q.size());
+    for (const std::int32_t c : active) r_[c] = -q[c];
+    p = apply(r_);
+    return refined ? refine(p) : p.allFinite();
+  }
+
+  // Iterative refinement of the last solve's answer p against W_AA + delta I: one step after a
+  // fresh factorisation, up to kMaxRefinements while the residual halves after a bordered solve,
+  // whose Schur complement loses digits on the nearly redundant contacts (with one step the
+  // two-grain block test stalled at impulse changes of 4e-12 between Newton iterations). What
+  // solve(..., refined = false) leaves out; false if p is not finite.
+  bool refine(Eigen::VectorXd& p) {
+    if (active_.empty()) return true;
     // Stop at round-off: a residual within a few ulps of r's largest entry cannot fall further.
-    const double floor = 8 * std::numeric_limits<double>::epsilon() * r.cwiseAbs().maxCoeff();
+    const double floor = 8 * std::numeric_limits<double>::epsilon() * r_.cwiseAbs().maxCoeff();
     double last = std::numeric_limits<double>::infinity();
     for (int k = 0; k < (bordered_.empty() ? 1 : kMaxRefinements); ++k) {
       // r - (W + delta I) x on A (x = 0 off A), 0 elsewhere; row c of W is its column c (W is
       // symmetric), so each contact's entry is one pass over its column, on the threads.
-      Eigen::VectorXd res = Eigen::VectorXd::Zero(r.size());
-      const auto na = static_cast<std::ptrdiff_t>(active.size());
+      Eigen::VectorXd res = Eigen::VectorXd::Zero(r_.size());
+      const auto na = static_cast<std::ptrdiff_t>(active_.size());
       ThreadedRegion region(timers_, na > kThreadedRows);
 #pragma omp parallel for schedule(static) if (na > kThreadedRows)
       for (std::ptrdiff_t a = 0; a < na; ++a) {
-        const std::int32_t c = active[static_cast<std::size_t>(a)];
+        const std::int32_t c = active_[static_cast<std::size_t>(a)];
         double acc = 0;
         for (Eigen::SparseMatrix<double>::InnerIterator it(W_, c); it; ++it)
-          if (in_active_[static_cast<std::size_t>(it.row())]) acc += it.value() * x[it.row()];
-        res[c] = r[c] - f_.delta * x[c] - acc;
+          if (in_active_[static_cast<std::size_t>(it.row())]) acc += it.value() * p[it.row()];
+        res[c] = r_[c] - f_.delta * p[c] - acc;
       }
       region.done();
       const double norm = res.cwiseAbs().maxCoeff();
       if (!(norm < 0.5 * last) || norm <= floor) break;
       last = norm;
-      x += apply(res);
+      p += apply(res);
     }
-    if (!x.allFinite()) return false;
-    p = x;
-    return true;
+    return p.allFinite();
   }
 
  private:
@@ -434,7 +469,9 @@ class ShiftedSolver {
   StageTimers* timers_;                 // see the constructor
   std::vector<std::int32_t> bordered_;  // N (entered), then R (left)
   std::size_t n_entered_ = 0;
-  std::vector<char> in_active_;  // per contact: in the active set of this solve
+  std::vector<char> in_active_;       // per contact: in the active set of this solve
+  std::vector<std::int32_t> active_;  // the active set of the last solve (ascending)
+  Eigen::VectorXd r_;                 // its right-hand side: -q on the active set, 0 elsewhere
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_;
 };
 
@@ -457,7 +494,9 @@ std::pair<double, double> violation(const NormalSystem& sys, const Eigen::Vector
 // the free set F; if a free impulse would turn negative, move toward the solution until the first
 // one reaches 0 and fix it; else free the contact whose velocity w_c / W_cc is the most negative.
 // The objective falls at every step, so it does not cycle where the block pivoting does (nearly
-// redundant face contacts of split points, docs/contact.md). Counts its solves in `pivots`; false
+// redundant face contacts of split points, docs/contact.md). Its solves are refined only when
+// they are the answer (no impulse would turn negative): the step length needs no more digits.
+// Counts its solves in `pivots`; false
 // after `max_steps` solves, on a failed solve or when the contact just freed is fixed again at
 // once (round-off).
 bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>& W,
@@ -476,7 +515,7 @@ bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>&
     for (Eigen::Index c = 0; c < m; ++c)
       if (free[c]) idx.push_back(static_cast<std::int32_t>(c));
     ++pivots;
-    if (!solver.solve(idx, q, z)) return false;
+    if (!solver.solve(idx, q, z, false)) return false;
     double alpha = 1.0;
     std::int32_t hit = -1;
     for (const std::int32_t c : idx)
@@ -496,6 +535,7 @@ bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>&
       continue;
     }
     x = z;
+    if (!solver.refine(x)) return false;
     shifted_product(W, x, q, delta, w, solver.timers());
     const double scale = std::max(x.cwiseAbs().maxCoeff(), q_scale);
     double most = -1e-12 * scale;  // the block pivoting's feasibility tolerance
@@ -587,8 +627,18 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       q = sys.b - delta * p;
       // The starting active set: the contacts whose local solution (the others' impulses fixed)
       // has a positive impulse, p_c - w_c / M_cc > 0 (the semismooth-Newton rule).
-      shifted_product(W, p, q, delta, w, settings.timers);
-      for (Eigen::Index c = 0; c < m; ++c) active[c] = p[c] - w[c] / (d[c] + delta) > 0.0;
+      // With a new W (the first solve of a step) in a large problem the rule is applied after
+      // kWSweeps projected Gauss-Seidel sweeps on W from p, which cost a few products with W and
+      // bring the first active set closer: in the dense d/8 state the first pivot flips about
+      // 210 contacts instead of 410, with one factorisation fewer per step (docs/contact.md).
+      // Not in small problems, which need few pivots anyway: there the guess after the sweeps,
+      // with many contacts near p_c = w_c = 0, made the 3D head-on impact's path depend on
+      // round-off (ThreeD.DenseAndSparseGrainFactorisationsTakeTheSameSteps).
+      Eigen::VectorXd guess = p;
+      if (!reuse && outer == 0 && m > kThreadedRows)
+        sweep_on_w(W, q, d, delta, guess, kWSweeps, settings.timers);
+      shifted_product(W, guess, q, delta, w, settings.timers);
+      for (Eigen::Index c = 0; c < m; ++c) active[c] = guess[c] - w[c] / (d[c] + delta) > 0.0;
       // Block principal pivoting (Judice & Pires 1994): flip every infeasible contact while
       // their number falls (three more tries when it does not). When it stops falling, the
       // infeasible contacts left are a few nearly redundant ones that block flips trade back and
@@ -602,17 +652,29 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
         for (Eigen::Index c = 0; c < m; ++c)
           if (active[c]) idx.push_back(static_cast<std::int32_t>(c));
         ++result.pivots;
-        if (!solver.solve(idx, q, next)) break;
-        shifted_product(W, next, q, delta, w, settings.timers);
-        double scale = next.cwiseAbs().maxCoeff();
-        for (Eigen::Index c = 0; c < m; ++c) scale = std::max(scale, std::abs(q[c]) / d[c]);
-        const double tol = 1e-12 * scale;
-        infeasible.clear();
-        for (Eigen::Index c = 0; c < m; ++c)
-          if (active[c] ? next[c] < -tol : w[c] / (d[c] + delta) < -tol)
-            infeasible.push_back(static_cast<std::int32_t>(c));
+        // In a large problem (from kThreadedRows contacts) a pivot's solve is refined only once
+        // its active set looks right: the flips need the signs, not the last digits (the dense
+        // d/8 state: refining every pivot's solve took a third of the pivoting). A small one
+        // refines every pivot: the walled blocks' staggering at a tolerance of 1e-12 needs that
+        // path (with unrefined pivots, impulse changes stalled at 2-3.5e-12, docs/contact.md).
+        const bool refine_each = m <= kThreadedRows;
+        if (!solver.solve(idx, q, next, refine_each)) break;
+        bool refined = refine_each;
+        for (;;) {
+          shifted_product(W, next, q, delta, w, settings.timers);
+          double scale = next.cwiseAbs().maxCoeff();
+          for (Eigen::Index c = 0; c < m; ++c) scale = std::max(scale, std::abs(q[c]) / d[c]);
+          const double tol = 1e-12 * scale;
+          infeasible.clear();
+          for (Eigen::Index c = 0; c < m; ++c)
+            if (active[c] ? next[c] < -tol : w[c] / (d[c] + delta) < -tol)
+              infeasible.push_back(static_cast<std::int32_t>(c));
+          if (!infeasible.empty() || refined) break;
+          if (!solver.refine(next)) break;
+          refined = true;
+        }
         if (infeasible.empty()) {
-          pivoted = true;
+          pivoted = refined;
           break;
         }
         if (infeasible.size() < best) {
