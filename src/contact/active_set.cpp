@@ -188,10 +188,10 @@ void shifted_product(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd
 // dense d/8 state the changes fall 160, 70, 27, 13, 19, 19, 11, 12, 10, then 3-10 per sweep). The
 // contacts are swept in two fixed halves at once, each in order with the other half's values of
 // the previous sweep (block Jacobi between the halves), so the answer is the same bits on any
-// thread count. On the threads from kThreadedRows contacts. Returns the sweeps done.
-int sweep_on_w(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd& q,
-               const Eigen::VectorXd& d, double delta, Eigen::VectorXd& x, int sweeps,
-               StageTimers* timers) {
+// thread count. On the threads from kThreadedRows contacts.
+void sweep_on_w(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd& q,
+                const Eigen::VectorXd& d, double delta, Eigen::VectorXd& x, int sweeps,
+                StageTimers* timers) {
   const Eigen::Index m = W.cols(), half = m / 2;
   Eigen::VectorXd before(m);
   for (int k = 0; k < sweeps; ++k) {
@@ -215,9 +215,8 @@ int sweep_on_w(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd& q,
       flips[static_cast<std::size_t>(part)] = n;
     }
     region.done();
-    if (flips[0] + flips[1] <= m / 1000) return k + 1;
+    if (flips[0] + flips[1] <= m / 1000) return;
   }
-  return sweeps;
 }
 
 // Solves with W_AA + delta I (sparse LDL^T) kept in a ShiftedFactor: the proximal steps of one
@@ -507,9 +506,8 @@ std::pair<double, double> violation(const NormalSystem& sys, const Eigen::Vector
 // The objective falls at every step, so it does not cycle where the block pivoting does (nearly
 // redundant face contacts of split points, docs/contact.md). Its solves are refined only when
 // they are the answer (no impulse would turn negative): the step length needs no more digits.
-// Counts its solves in `pivots`; false
-// after `max_steps` solves, on a failed solve or when the contact just freed is fixed again at
-// once (round-off).
+// Counts its solves in `pivots`; false after `max_steps` solves, on a failed solve or when the
+// contact just freed is fixed again at once (round-off).
 bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>& W,
                        const Eigen::VectorXd& q, const Eigen::VectorXd& d, double delta,
                        Eigen::VectorXd& x, int max_steps, int& pivots) {
@@ -639,9 +637,9 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       // The starting active set: the contacts whose local solution (the others' impulses fixed)
       // has a positive impulse, p_c - w_c / M_cc > 0 (the semismooth-Newton rule).
       // With a new W (the first solve of a step) in a large problem the rule is applied after
-      // kWSweeps projected Gauss-Seidel sweeps on W from p, which cost a few products with W and
-      // bring the first active set closer: in the dense d/8 state the first pivot flips about
-      // 210 contacts instead of 410, with one factorisation fewer per step (docs/contact.md).
+      // up to kWSweeps projected Gauss-Seidel sweeps on W from p (sweep_on_w), which cost a few
+      // products with W and bring the first active set closer: in the dense d/8 state the first
+      // pivot flips about 210 contacts instead of 410 (docs/contact.md).
       // Not in small problems, which need few pivots anyway: there the guess after the sweeps,
       // with many contacts near p_c = w_c = 0, made the 3D head-on impact's path depend on
       // round-off (ThreeD.DenseAndSparseGrainFactorisationsTakeTheSameSteps).
