@@ -13,6 +13,7 @@
 
 #include "../tests/support/contact_problems.hpp"
 #include "../tests/support/sparse_matrices.hpp"
+#include "mpmcd/core/dense_lapack.hpp"
 #include "mpmcd/core/tree_ldlt.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "slice_300.hpp"
@@ -114,7 +115,35 @@ void BM_TreeLdlt(benchmark::State& state) {
   state.counters["split_speedup"] = ldlt.split_speedup();
 }
 
+// The dense top's kernel (dense::cholesky_upper_on_threads, blocks of 96 rows) on an n x n SPD
+// matrix, copy included, on `threads` threads; the counter GFlops is n^3 / 3 over the time, and
+// the label OpenBLAS's kernels (docs/parallel.md, "The top rows as a dense Schur complement").
+void BM_DenseTopCholesky(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  const Eigen::MatrixXd R = Eigen::MatrixXd::Random(n, n);
+  const Eigen::MatrixXd A = R * R.transpose() + n * Eigen::MatrixXd::Identity(n, n);
+  Eigen::MatrixXd U(n, n);
+  for (auto _ : state) {
+    U = A;
+    if (!dense::cholesky_upper_on_threads(U.data(), n)) state.SkipWithError("not SPD");
+    benchmark::DoNotOptimize(U.data());
+  }
+  state.counters["GFlops"] = benchmark::Counter(static_cast<double>(n) * n * n / 3e9,
+                                                benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(dense::kernels());
+}
+
 }  // namespace
+
+BENCHMARK(BM_DenseTopCholesky)
+    ->ArgNames({"n", "threads"})
+    ->Args({500, 1})
+    ->Args({500, 2})
+    ->Args({1000, 1})
+    ->Args({1000, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 BENCHMARK(BM_TreeLdlt)
     ->ArgNames({"n", "ways", "threads"})

@@ -1,5 +1,7 @@
 #include "mpmcd/core/tree_ldlt.hpp"
 
+#include "mpmcd/core/dense_lapack.hpp"
+
 #include <omp.h>
 #include <suitesparse/amd.h>
 
@@ -19,6 +21,13 @@ constexpr std::size_t kSubtreesPerWay = 32;
 constexpr double kMinSpeedup = 1.15;
 // Rows of the top, at most (each way keeps a dense |top| x |top| block of contributions) [-].
 constexpr std::size_t kMaxTopRows = 1500;
+// Top rows from which a dense top may be chosen [-].
+constexpr std::size_t kMinDenseTop = 64;
+// Multiply-adds per second of the dense top (its kernels, the complement's assembly and the
+// entries' write-back) over the sparse rows' loop, on one thread [-]: the d/8 paper state at
+// Phi = 0.95 (20 factorisations of W_AA, 318-672 top rows), 3.1e9 against 0.87e9
+// (docs/parallel.md).
+constexpr double kDenseRate = 3.5;
 }  // namespace
 
 template <class Add>
@@ -69,6 +78,7 @@ void TreeLdlt::compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways
   analyzePattern_preordered(*pmat, true);
   const CholMatrixType& ap = *pmat;
   split_ = false;
+  top_dense_ = false;
   top_.clear();
   split_speedup_ = 1.0;
   if (ways > 1 && n >= min_size) split(ap, ways);
@@ -113,8 +123,9 @@ void TreeLdlt::compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways
     for (std::size_t t = 0; t < nt; ++t) top_row_part(ap, t, static_cast<std::int32_t>(b), bin);
   }
   region.done();
-  // The top rows on one thread, with the ways' parts.
-  if (ok) {
+  // The top rows: dense on the threads, or (not positive definite, or chosen) on one thread.
+  if (ok && top_dense_ && !top_dense(ap)) top_dense_ = false;
+  if (ok && !top_dense_) {
     std::vector<double> y(nu, 0.0);
     std::vector<std::int32_t> pattern(nu), tags(nu, -1);
     for (std::size_t t = 0; t < nt && ok; ++t)
@@ -277,6 +288,73 @@ bool TreeLdlt::top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t
   return m_diag[k] != 0.0;
 }
 
+bool TreeLdlt::top_dense(const Eigen::SparseMatrix<double>& ap) {
+  // S = A_TT + shift + sum over the ways of their parts (by top position; column t of its upper
+  // triangle is top row t, as in Bin::contributions), S = U^T U, and then the rows of L: with
+  // U = D^(1/2) L_TT^T, L(k_t, k_s) = U_st / U_ss and D_t = U_tt^2.
+  const std::size_t nt = top_.size();
+  schur_.resize(nt * nt);
+  const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
+  {
+    ThreadedRegion region(timers_, threads > 1);
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
+    for (std::size_t t = 0; t < nt; ++t) {
+      double* s = schur_.data() + t * nt;
+      std::fill_n(s, t + 1, 0.0);
+      const std::int32_t k = top_[t];
+      for (Eigen::SparseMatrix<double>::InnerIterator it(ap, k); it; ++it) {
+        const auto i = static_cast<std::size_t>(it.index());
+        if (owner_[i] < 0) s[top_pos_[i]] += it.value();
+      }
+      s[t] = s[t] * m_shiftScale + m_shiftOffset;
+      for (const Bin& bin : bins_) {
+        const double* c = bin.contributions.data() + t * nt;
+        for (std::size_t r = 0; r < t; ++r) s[r] += c[r];
+        s[t] += bin.partial_d[t];
+      }
+    }
+    region.done();
+    ThreadedRegion factoring(timers_, threads > 1);
+    if (!dense::cholesky_upper_on_threads(schur_.data(), static_cast<int>(nt))) return false;
+  }
+  // Each top row's reach over the top's columns (as top_row_rest), its entries from U.
+  const auto size = static_cast<std::int32_t>(ap.rows());
+  const int* parent = m_parent.data();
+  const int* Lp = m_matrix.outerIndexPtr();
+  int* Li = m_matrix.innerIndexPtr();
+  double* Lx = m_matrix.valuePtr();
+  int* count = m_nonZerosPerCol.data();
+  std::vector<std::int32_t> pattern(static_cast<std::size_t>(size)), tags(pattern.size(), -1);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const std::int32_t k = top_[t];
+    std::int32_t top = size;
+    tags[k] = k;
+    count[k] = 0;
+    const auto reach = [&](std::int32_t i) {
+      for (; tags[i] != k; i = parent[i]) {
+        pattern[--top] = i;
+        tags[i] = k;
+      }
+    };
+    for (Eigen::SparseMatrix<double>::InnerIterator it(ap, k); it; ++it)
+      if (owner_[static_cast<std::size_t>(it.index())] < 0)
+        reach(static_cast<std::int32_t>(it.index()));
+    for (const Bin& bin : bins_)
+      for (std::int32_t s = bin.start_ptr[t]; s < bin.start_ptr[t + 1]; ++s)
+        reach(bin.starts[static_cast<std::size_t>(s)]);
+    const double* u = schur_.data() + t * nt;
+    for (; top < size; ++top) {
+      const std::int32_t i = pattern[top];
+      const auto s = static_cast<std::size_t>(top_pos_[static_cast<std::size_t>(i)]);
+      const int p = Lp[i] + count[i]++;
+      Li[p] = k;
+      Lx[p] = u[s] / schur_[s * nt + s];
+    }
+    m_diag[k] = u[t] * u[t];
+  }
+  return true;
+}
+
 bool TreeLdlt::factor_row(const Eigen::SparseMatrix<double>& ap, Eigen::Index k, double* y,
                           std::int32_t* pattern, std::int32_t* tags) {
   // Eigen's SimplicialCholeskyBase::factorize_preordered<true>, the body of its loop over k
@@ -411,6 +489,14 @@ void TreeLdlt::split(const Eigen::SparseMatrix<double>& ap, int ways) {
     }
   double top_rows_work = 0;
   for (const std::int32_t k : top_) top_rows_work += work[static_cast<std::size_t>(k)];
+  // The dense top's work: n^3 / 6 multiply-adds for n rows, at about kDenseRate times the
+  // sparse loop's rate.
+  const auto top_size = static_cast<double>(top_.size());
+  const double dense_work = top_size * top_size * top_size / 6.0 / kDenseRate;
+  top_dense_ =
+      top_mode_ == TopMode::dense || (top_mode_ == TopMode::automatic &&
+                                      top_.size() >= kMinDenseTop && dense_work < top_rows_work);
+  if (top_dense_) top_rows_work = dense_work / ways;
   split_speedup_ = total / (top_rows_work + *std::max_element(load.begin(), load.end()));
   split_ = true;
 }

@@ -8,6 +8,13 @@
 
 namespace mpmcd::dense {
 
+/// OpenBLAS's name of the kernels in use (e.g. "SkylakeX", "Haswell", "Prescott").
+const char* kernels();
+
+/// Whether mpmcd chose the kernels again at start-up: OpenBLAS had fallen back to "Prescott" on
+/// a CPU with AVX2 or AVX-512 that it does not know, and OPENBLAS_CORETYPE was not set.
+bool kernels_reselected();
+
 /// In-place Cholesky factorisation A = L L^T of the symmetric matrix whose lower triangle A holds
 /// (LAPACK dpotrf); L in the lower triangle, the strict upper triangle untouched. False when A is
 /// not positive definite (A's content is then unspecified).
@@ -21,6 +28,15 @@ void lower_transpose_solve(const Eigen::MatrixXd& L, Eigen::VectorXd& x);
 
 /// x <- (L L^T)^-1 x (LAPACK dpotrs).
 void cholesky_solve(const Eigen::MatrixXd& L, Eigen::VectorXd& x);
+
+/// In-place Cholesky factorisation A = U^T U of the n x n column-major symmetric matrix whose
+/// upper triangle `a` holds (leading dimension n), by blocks of `block` rows on the OpenMP
+/// threads (right-looking: LAPACK dpotrf on each diagonal block, BLAS dtrsm on its row, dsyrk
+/// and dgemm on the trailing blocks; Golub & Van Loan, Matrix Computations, 4th ed., Alg.
+/// 4.2.10). Each block's sequence of kernels is fixed, so the bits do not depend on the thread
+/// count. U in the upper triangle, the strict lower triangle untouched. False when A is not
+/// positive definite (its content is then unspecified).
+bool cholesky_upper_on_threads(double* a, int n, int block = 96);
 
 /// G = Y^T Y, both triangles (BLAS dsyrk on the lower one, mirrored); Y is n x m, G becomes
 /// m x m.

@@ -8,9 +8,11 @@
 /// closed under parents). The subtrees' rows are factorised on the threads, each subtree in
 /// ascending order on one thread; then each top row in ascending order, its solve over each
 /// subtree's columns on the threads (what they subtract from the top's rows kept per subtree)
-/// and its solve over the top's columns on one thread, the subtrees' parts added in subtree
-/// order. The subtrees' rows are the bits of Eigen's factorize_preordered; a top row differs
-/// from Eigen's by the order of its sums (round-off); the split depends on the matrix only.
+/// and its solve over the top's columns either on one thread, the subtrees' parts added in
+/// subtree order, or, when the top's part of L is dense enough, as the dense Cholesky
+/// factorisation of the top's Schur complement on the threads (top_dense()). The subtrees' rows
+/// are the bits of Eigen's factorize_preordered; a top row differs from Eigen's by the order of
+/// its sums (round-off); the split and the choice depend on the matrix only.
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -49,8 +51,19 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
   /// (sum over columns of c (c - 1) / 2, c their entries) divided by the largest way's subtrees'
   /// plus the top's [-]; 1 when it was not split.
   double split_speedup() const { return split_speedup_; }
-  /// Rows of the last factorisation's top (left on one thread) [-].
+  /// Rows of the last factorisation's top [-].
   std::int64_t top_rows() const { return static_cast<std::int64_t>(top_.size()); }
+
+  /// How the top rows are factorised: `automatic` chooses by the density of their part of L.
+  enum class TopMode {
+    automatic,  ///< dense when its flops are not many more than the sparse loop's (split())
+    sparse,     ///< the up-looking rows on one thread, as Eigen's loop
+    dense,      ///< the dense Schur complement on the threads (top_dense())
+  };
+  /// Sets how the next factorisations treat the top rows (default: automatic).
+  void set_top_mode(TopMode mode) { top_mode_ = mode; }
+  /// Whether the last factorisation's top rows were factorised dense.
+  bool top_was_dense() const { return top_dense_; }
 
  private:
   // One way of the split: its subtrees' rows and work arrays, and its parts of the top rows.
@@ -83,15 +96,23 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
   // Top row t's solve over the top's columns and D_kk: false if D_kk = 0.
   bool top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t, double* y,
                     std::int32_t* pattern, std::int32_t* tags);
+  // The top rows by the Cholesky factorisation of their Schur complement (A's top block, the
+  // shift and the ways' parts) as a dense matrix on the threads, its entries then written into
+  // L along the rows' reach (the structural zeros of L come out of it as exact zeros): false if
+  // the complement is not positive definite (L's top columns not written).
+  bool top_dense(const Eigen::SparseMatrix<double>& ap);
 
-  bool split_ = false;                 ///< the last factorisation was split
-  std::vector<Bin> bins_;              ///< the split's ways (their storage kept between calls)
-  std::vector<std::int32_t> top_;      ///< rows above the subtrees, ascending [-]
-  std::vector<std::int32_t> top_pos_;  ///< per row: its index in top_, or -1 [-]
-  std::vector<std::int32_t> owner_;    ///< per row: its bin, -1 in the top [-]
-  std::vector<int> below_;             ///< per subtree column: its entries in its subtree [-]
-  double split_speedup_ = 1.0;         ///< see split_speedup() [-]
-  StageTimers* timers_ = nullptr;      ///< see set_timers()
+  bool split_ = false;                     ///< the last factorisation was split
+  std::vector<Bin> bins_;                  ///< the split's ways (their storage kept between calls)
+  std::vector<std::int32_t> top_;          ///< rows above the subtrees, ascending [-]
+  std::vector<std::int32_t> top_pos_;      ///< per row: its index in top_, or -1 [-]
+  std::vector<std::int32_t> owner_;        ///< per row: its bin, -1 in the top [-]
+  std::vector<int> below_;                 ///< per subtree column: its entries in its subtree [-]
+  double split_speedup_ = 1.0;             ///< see split_speedup() [-]
+  TopMode top_mode_ = TopMode::automatic;  ///< see set_top_mode()
+  bool top_dense_ = false;                 ///< the split chose a dense top (see top_was_dense())
+  std::vector<double> schur_;      ///< the top's Schur complement, then its U (top_dense()) [A's]
+  StageTimers* timers_ = nullptr;  ///< see set_timers()
 };
 
 }  // namespace mpmcd

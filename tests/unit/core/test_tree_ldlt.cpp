@@ -137,6 +137,65 @@ TEST(TreeLdlt, SubstitutionsOnTheThreadsAgreeWithEigensSolveAndGiveTheSameBits) 
   EXPECT_EQ(w, whole.solve(b));
 }
 
+// Factorises `A` + shift I by `tree` split for 2 on `threads` threads, its top rows `mode`.
+void tree_factor(mpmcd::TreeLdlt& tree, const Eigen::SparseMatrix<double>& A, double shift,
+                 int threads, mpmcd::TreeLdlt::TopMode mode) {
+  tree.set_top_mode(mode);
+  tree_factor(tree, A, shift, threads);
+}
+
+TEST(TreeLdlt, DenseTopAgreesWithTheSparseTopToRoundOffAndGivesTheSameBits) {
+  // The top rows by the dense Cholesky factorisation of their Schur complement on the threads:
+  // the same pattern of L as the up-looking rows (its structural zeros exact zeros), the values
+  // to round-off, the same bits on 1 and 2 threads; the solve's residual.
+  using Mode = mpmcd::TreeLdlt::TopMode;
+  const Eigen::SparseMatrix<double> A = grid_matrix(60, 50, 1e-3, 7);
+  const double shift = 1e-9;
+  mpmcd::TreeLdlt sparse, two, one;
+  tree_factor(sparse, A, shift, 2, Mode::sparse);
+  tree_factor(two, A, shift, 2, Mode::dense);
+  tree_factor(one, A, shift, 1, Mode::dense);
+  ASSERT_EQ(sparse.info(), Eigen::Success);
+  ASSERT_EQ(two.info(), Eigen::Success);
+  EXPECT_FALSE(sparse.top_was_dense());
+  EXPECT_TRUE(two.top_was_dense());
+  ASSERT_GT(two.top_rows(), 0);
+  expect_same_bits(two, one);
+  const auto& L1 = sparse.matrixL().nestedExpression();
+  const auto& L2 = two.matrixL().nestedExpression();
+  ASSERT_EQ(L1.nonZeros(), L2.nonZeros());
+  double worst = 0;
+  for (Eigen::Index k = 0; k < L1.nonZeros(); ++k) {
+    ASSERT_EQ(L1.innerIndexPtr()[k], L2.innerIndexPtr()[k]) << k;
+    worst = std::max(worst, std::abs(L1.valuePtr()[k] - L2.valuePtr()[k]));
+  }
+  EXPECT_GT(worst, 0.0);
+  EXPECT_LT(worst, 1e-10);
+  EXPECT_LT((sparse.vectorD() - two.vectorD()).cwiseAbs().maxCoeff(),
+            1e-12 * sparse.vectorD().cwiseAbs().maxCoeff());
+  Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
+  const Eigen::VectorXd b = x;
+  two.solve_in_place(x);
+  Eigen::SparseMatrix<double> I(A.rows(), A.cols());
+  I.setIdentity();
+  const Eigen::SparseMatrix<double> shifted = A + shift * I;
+  EXPECT_LT((shifted * x - b).norm(), 1e-9 * b.norm());
+}
+
+TEST(TreeLdlt, DenseTopFallsBackToTheSparseRowsWhenNotPositiveDefinite) {
+  // -A: LDL^T exists (all pivots negative), Cholesky does not; the top rows then come from the
+  // up-looking loop, the same bits as asked for it.
+  using Mode = mpmcd::TreeLdlt::TopMode;
+  const Eigen::SparseMatrix<double> A = -grid_matrix(60, 50, 1e-3, 7);
+  mpmcd::TreeLdlt sparse, dense;
+  tree_factor(sparse, A, 0.0, 2, Mode::sparse);
+  tree_factor(dense, A, 0.0, 2, Mode::dense);
+  ASSERT_EQ(dense.info(), Eigen::Success);
+  EXPECT_FALSE(dense.top_was_dense());
+  expect_same_bits(sparse, dense);
+  EXPECT_LT(dense.vectorD().maxCoeff(), 0.0);
+}
+
 TEST(TreeLdlt, ZeroPivotIsReported) {
   // A singular matrix (the grid's couplings without a diagonal term have the constant-like
   // null vector of a signed graph Laplacian only if balanced; a zero block is singular for sure).
