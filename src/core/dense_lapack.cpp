@@ -42,7 +42,8 @@ namespace {
 // OpenBLAS does at load time for OPENBLAS_CORETYPE. Run before main (a static initialiser of
 // this file, after OpenBLAS's own), single-threaded and before any BLAS call.
 bool select_kernels() {
-  if (std::getenv("OPENBLAS_CORETYPE") != nullptr || gotoblas_dynamic_init == nullptr ||
+  const char* chosen = std::getenv("OPENBLAS_CORETYPE");
+  if ((chosen != nullptr && *chosen != 0) || gotoblas_dynamic_init == nullptr ||
       gotoblas_dynamic_quit == nullptr || std::strcmp(openblas_get_corename(), "Prescott") != 0)
     return false;
   __builtin_cpu_init();
