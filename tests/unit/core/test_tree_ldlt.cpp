@@ -36,6 +36,28 @@ void expect_same_bits(const mpmcd::TreeLdlt& a, const mpmcd::TreeLdlt& b) {
   ASSERT_EQ(a.vectorD(), b.vectorD());
 }
 
+// The largest difference between the values of two factors of the same pattern (checked).
+double worst_difference(const mpmcd::TreeLdlt& a, const mpmcd::TreeLdlt& b) {
+  const auto& La = a.matrixL().nestedExpression();
+  const auto& Lb = b.matrixL().nestedExpression();
+  EXPECT_EQ(La.nonZeros(), Lb.nonZeros());
+  double worst = 0;
+  for (Eigen::Index k = 0; k < std::min(La.nonZeros(), Lb.nonZeros()); ++k) {
+    EXPECT_EQ(La.innerIndexPtr()[k], Lb.innerIndexPtr()[k]) << k;
+    worst = std::max(worst, std::abs(La.valuePtr()[k] - Lb.valuePtr()[k]));
+  }
+  return worst;
+}
+
+// |(A + shift I) x - b| / |b|.
+double relative_residual(const Eigen::SparseMatrix<double>& A, double shift,
+                         const Eigen::VectorXd& x, const Eigen::VectorXd& b) {
+  Eigen::SparseMatrix<double> I(A.rows(), A.cols());
+  I.setIdentity();
+  const Eigen::SparseMatrix<double> shifted = A + shift * I;
+  return (shifted * x - b).norm() / b.norm();
+}
+
 TEST(TreeLdlt, OneWayIsEigensLoopOnItsOrdering) {
   // Without a split, the numeric factorisation is Eigen's on the matrix permuted by AMD's
   // order: Eigen's SimplicialLDLT without ordering on P A P^T gives the same bits.
@@ -75,24 +97,13 @@ TEST(TreeLdlt, SplitAgreesToRoundOffAndGivesTheSameBitsOnOneAndTwoThreads) {
   EXPECT_LT(two.top_rows(), 400);
   expect_same_bits(two, one);
   // The unsplit factor: the same pattern, values to round-off.
-  const auto& L1 = serial.matrixL().nestedExpression();
-  const auto& L2 = two.matrixL().nestedExpression();
-  ASSERT_EQ(L1.nonZeros(), L2.nonZeros());
-  double worst = 0;
-  for (Eigen::Index k = 0; k < L1.nonZeros(); ++k) {
-    ASSERT_EQ(L1.innerIndexPtr()[k], L2.innerIndexPtr()[k]) << k;
-    worst = std::max(worst, std::abs(L1.valuePtr()[k] - L2.valuePtr()[k]));
-  }
+  const double worst = worst_difference(serial, two);
   EXPECT_GT(worst, 0.0);  // the top rows sum in another order
   EXPECT_LT(worst, 1e-10);
   EXPECT_LT((serial.vectorD() - two.vectorD()).cwiseAbs().maxCoeff(),
             1e-12 * serial.vectorD().cwiseAbs().maxCoeff());
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
-  const Eigen::VectorXd x = two.solve(b);
-  Eigen::SparseMatrix<double> I(A.rows(), A.cols());
-  I.setIdentity();
-  const Eigen::SparseMatrix<double> shifted = A + shift * I;
-  EXPECT_LT((shifted * x - b).norm(), 1e-9 * b.norm());
+  EXPECT_LT(relative_residual(A, shift, two.solve(b), b), 1e-9);
 }
 
 TEST(TreeLdlt, SubstitutionsOnTheThreadsAgreeWithEigensSolveAndGiveTheSameBits) {
@@ -124,10 +135,7 @@ TEST(TreeLdlt, SubstitutionsOnTheThreadsAgreeWithEigensSolveAndGiveTheSameBits) 
   const double scale = eigen.cwiseAbs().maxCoeff();
   EXPECT_GT((two - eigen).cwiseAbs().maxCoeff(), 0.0);  // the top rows sum in another order
   EXPECT_LT((two - eigen).cwiseAbs().maxCoeff(), 1e-11 * scale);
-  Eigen::SparseMatrix<double> I(A.rows(), A.cols());
-  I.setIdentity();
-  const Eigen::SparseMatrix<double> shifted = A + shift * I;
-  EXPECT_LT((shifted * two - b).norm(), 1e-9 * b.norm());
+  EXPECT_LT(relative_residual(A, shift, two, b), 1e-9);
   // Unsplit, it is Eigen's solve().
   mpmcd::TreeLdlt whole;
   whole.setShift(shift);
@@ -161,14 +169,7 @@ TEST(TreeLdlt, DenseTopAgreesWithTheSparseTopToRoundOffAndGivesTheSameBits) {
   EXPECT_TRUE(two.top_was_dense());
   ASSERT_GT(two.top_rows(), 0);
   expect_same_bits(two, one);
-  const auto& L1 = sparse.matrixL().nestedExpression();
-  const auto& L2 = two.matrixL().nestedExpression();
-  ASSERT_EQ(L1.nonZeros(), L2.nonZeros());
-  double worst = 0;
-  for (Eigen::Index k = 0; k < L1.nonZeros(); ++k) {
-    ASSERT_EQ(L1.innerIndexPtr()[k], L2.innerIndexPtr()[k]) << k;
-    worst = std::max(worst, std::abs(L1.valuePtr()[k] - L2.valuePtr()[k]));
-  }
+  const double worst = worst_difference(sparse, two);
   EXPECT_GT(worst, 0.0);
   EXPECT_LT(worst, 1e-10);
   EXPECT_LT((sparse.vectorD() - two.vectorD()).cwiseAbs().maxCoeff(),
@@ -176,10 +177,7 @@ TEST(TreeLdlt, DenseTopAgreesWithTheSparseTopToRoundOffAndGivesTheSameBits) {
   Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
   const Eigen::VectorXd b = x;
   two.solve_in_place(x);
-  Eigen::SparseMatrix<double> I(A.rows(), A.cols());
-  I.setIdentity();
-  const Eigen::SparseMatrix<double> shifted = A + shift * I;
-  EXPECT_LT((shifted * x - b).norm(), 1e-9 * b.norm());
+  EXPECT_LT(relative_residual(A, shift, x, b), 1e-9);
 }
 
 TEST(TreeLdlt, DenseTopFallsBackToTheSparseRowsWhenNotPositiveDefinite) {
