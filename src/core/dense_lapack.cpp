@@ -162,6 +162,14 @@ bool cholesky_upper_on_threads(double* a, int n, int block) {
   return ok;
 }
 
+void upper_cholesky_solve(const double* u, int n, double* x) {
+  one_thread();
+  const int inc = 1;
+  if (n <= 0) return;
+  dtrsv_("U", "T", "N", &n, u, &n, x, &inc);  // U^T y = x
+  dtrsv_("U", "N", "N", &n, u, &n, x, &inc);  // U x = y
+}
+
 void gram(const Eigen::Ref<const Eigen::MatrixXd>& Y, Eigen::MatrixXd& G) {
   one_thread();
   const int n = as_int(Y.rows()), m = as_int(Y.cols()), lda = std::max(1, as_int(Y.outerStride())),

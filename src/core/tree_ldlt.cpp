@@ -166,24 +166,38 @@ void TreeLdlt::solve_in_place(Eigen::VectorXd& b) const {
     }
   }
   forward.done();
-  // The top's columns (they reach top rows only), each row with the ways' parts first.
-  for (std::size_t t = 0; t < nt; ++t) {
-    const std::int32_t k = top_[t];
-    double xk = x[k];
-    for (std::size_t w = 0; w < nb; ++w) xk += acc[w * nt + t];
-    x[k] = xk;
-    if (xk == 0.0) continue;
-    for (int p = Lp[k]; p < Lp[k] + count[k]; ++p) x[Li[p]] -= Lx[p] * xk;
-  }
-  // Backward with the diagonal: row k of L^T x = D^-1 x reads its ancestors' entries, so the
-  // top (descending) first, then each way's subtrees (descending) on the threads.
   const double* d = m_diag.data();
   const auto back = [&](std::int32_t k) {
     double xk = x[k] * (1.0 / d[k]);
     for (int p = Lp[k]; p < Lp[k] + count[k]; ++p) xk -= Lx[p] * x[Li[p]];
     x[k] = xk;
   };
-  for (std::size_t t = nt; t-- > 0;) back(top_[t]);
+  if (top_dense_) {
+    // The top's columns and rows reach top rows only: their part of the two substitutions with
+    // the diagonal is x_T := S^-1 x_T, S = U^T U the top's Schur complement (top_dense()), after
+    // the ways' parts.
+    std::vector<double> xt(nt);
+    for (std::size_t t = 0; t < nt; ++t) {
+      double xk = x[top_[t]];
+      for (std::size_t w = 0; w < nb; ++w) xk += acc[w * nt + t];
+      xt[t] = xk;
+    }
+    dense::upper_cholesky_solve(schur_.data(), static_cast<int>(nt), xt.data());
+    for (std::size_t t = 0; t < nt; ++t) x[top_[t]] = xt[t];
+  } else {
+    // The top's columns (they reach top rows only), each row with the ways' parts first.
+    for (std::size_t t = 0; t < nt; ++t) {
+      const std::int32_t k = top_[t];
+      double xk = x[k];
+      for (std::size_t w = 0; w < nb; ++w) xk += acc[w * nt + t];
+      x[k] = xk;
+      if (xk == 0.0) continue;
+      for (int p = Lp[k]; p < Lp[k] + count[k]; ++p) x[Li[p]] -= Lx[p] * xk;
+    }
+    // Backward with the diagonal: row k of L^T x = D^-1 x reads its ancestors' entries, so the
+    // top (descending) first, then each way's subtrees (descending) on the threads.
+    for (std::size_t t = nt; t-- > 0;) back(top_[t]);
+  }
   {
     ThreadedRegion backward(timers_, threads > 1);
 #pragma omp parallel for schedule(static, 1) num_threads(threads)

@@ -38,6 +38,10 @@ void cholesky_solve(const Eigen::MatrixXd& L, Eigen::VectorXd& x);
 /// positive definite (its content is then unspecified).
 bool cholesky_upper_on_threads(double* a, int n, int block = 96);
 
+/// x <- (U^T U)^-1 x for the n x n upper-triangular U of cholesky_upper_on_threads (leading
+/// dimension n; BLAS dtrsv twice, on the calling thread).
+void upper_cholesky_solve(const double* u, int n, double* x);
+
 /// G = Y^T Y, both triangles (BLAS dsyrk on the lower one, mirrored); Y is n x m, G becomes
 /// m x m.
 void gram(const Eigen::Ref<const Eigen::MatrixXd>& Y, Eigen::MatrixXd& G);

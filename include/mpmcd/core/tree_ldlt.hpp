@@ -38,7 +38,8 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
   /// b := (A + shift I)^-1 b [b's units over A's], in place. After a split factorisation the
   /// forward substitution runs by the same subtrees on the threads, then the top rows, each
   /// way's part of them added in way order; the backward one the top rows first, then the
-  /// subtrees on the threads (Davis 2006, §4.7: column j of L only reaches j's ancestors). The
+  /// subtrees on the threads (Davis 2006, §4.7: column j of L only reaches j's ancestors); a
+  /// dense top's part of both is two dense triangular solves with its Cholesky factor. The
   /// same bits on any thread count and inside a parallel region (one thread); to round-off
   /// Eigen's solve() (the top rows' sums in another order). Unsplit: Eigen's solve().
   void solve_in_place(Eigen::VectorXd& b) const;

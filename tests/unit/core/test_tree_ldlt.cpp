@@ -155,7 +155,7 @@ void tree_factor(mpmcd::TreeLdlt& tree, const Eigen::SparseMatrix<double>& A, do
 TEST(TreeLdlt, DenseTopAgreesWithTheSparseTopToRoundOffAndGivesTheSameBits) {
   // The top rows by the dense Cholesky factorisation of their Schur complement on the threads:
   // the same pattern of L as the up-looking rows (its structural zeros exact zeros), the values
-  // to round-off, the same bits on 1 and 2 threads; the solve's residual.
+  // to round-off, the same bits on 1 and 2 threads; the solve with the dense top.
   using Mode = mpmcd::TreeLdlt::TopMode;
   const Eigen::SparseMatrix<double> A = grid_matrix(60, 50, 1e-3, 7);
   const double shift = 1e-9;
@@ -174,9 +174,19 @@ TEST(TreeLdlt, DenseTopAgreesWithTheSparseTopToRoundOffAndGivesTheSameBits) {
   EXPECT_LT(worst, 1e-10);
   EXPECT_LT((sparse.vectorD() - two.vectorD()).cwiseAbs().maxCoeff(),
             1e-12 * sparse.vectorD().cwiseAbs().maxCoeff());
-  Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
-  const Eigen::VectorXd b = x;
+  // The solve: the top's part by the dense factor, against the sparse top's to round-off, the
+  // same bits on 1 and 2 threads.
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
+  Eigen::VectorXd x = b, x1 = b, xs = b;
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(2);
   two.solve_in_place(x);
+  sparse.solve_in_place(xs);
+  omp_set_num_threads(1);
+  two.solve_in_place(x1);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(x, x1);
+  EXPECT_LT((x - xs).cwiseAbs().maxCoeff(), 1e-11 * xs.cwiseAbs().maxCoeff());
   EXPECT_LT(relative_residual(A, shift, x, b), 1e-9);
 }
 
