@@ -260,19 +260,16 @@ void TreeLdlt::top_row_part(const Eigen::SparseMatrix<double>& ap, std::size_t t
   bin.start_ptr[t + 1] = static_cast<std::int32_t>(bin.starts.size());
 }
 
-bool TreeLdlt::top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t, double* y,
-                            std::int32_t* pattern, std::int32_t* tags) {
-  // Top row k's solve over the top's columns: A's entries on the top's rows, the reach from
-  // them and from where the ways' parts left their subtrees (the top is closed under parents),
-  // then factor_row's loop, each way's contribution added, in way order, to y_i as it is used
-  // (the same sums for any thread count).
+std::int32_t TreeLdlt::top_reach(const Eigen::SparseMatrix<double>& ap, std::size_t t,
+                                 std::int32_t* pattern, std::int32_t* tags) {
+  // The reach of top row k over the top's columns, from A's entries on the top's rows and from
+  // where the ways' parts left their subtrees (the top is closed under parents), in topological
+  // order; column k emptied for the rows after it.
   const std::int32_t k = top_[t];
-  const auto size = static_cast<std::int32_t>(ap.rows());
   const int* parent = m_parent.data();
-  int* count = m_nonZerosPerCol.data();
-  std::int32_t top = size;
+  auto top = static_cast<std::int32_t>(ap.rows());
   tags[k] = k;
-  count[k] = 0;
+  m_nonZerosPerCol[k] = 0;
   const auto reach = [&](std::int32_t i) {
     std::int32_t len = 0;
     for (; tags[i] != k; i = parent[i]) {
@@ -281,19 +278,27 @@ bool TreeLdlt::top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t
     }
     while (len > 0) pattern[--top] = pattern[--len];
   };
-  for (Eigen::SparseMatrix<double>::InnerIterator it(ap, k); it; ++it) {
-    const auto i = static_cast<std::int32_t>(it.index());
-    if (owner_[static_cast<std::size_t>(i)] >= 0) continue;
-    y[i] += it.value();
-    reach(i);
-  }
-  double d = y[k] * m_shiftScale + m_shiftOffset;
-  y[k] = 0.0;
-  for (const Bin& bin : bins_) {
+  for (Eigen::SparseMatrix<double>::InnerIterator it(ap, k); it; ++it)
+    if (owner_[static_cast<std::size_t>(it.index())] < 0)
+      reach(static_cast<std::int32_t>(it.index()));
+  for (const Bin& bin : bins_)
     for (std::int32_t s = bin.start_ptr[t]; s < bin.start_ptr[t + 1]; ++s)
       reach(bin.starts[static_cast<std::size_t>(s)]);
-    d += bin.partial_d[t];
-  }
+  return top;
+}
+
+bool TreeLdlt::top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t, double* y,
+                            std::int32_t* pattern, std::int32_t* tags) {
+  // Top row k's solve over the top's columns: A's entries on the top's rows, over their reach
+  // (top_reach), then factor_row's loop, each way's contribution added, in way order, to y_i as
+  // it is used (the same sums for any thread count).
+  const std::int32_t k = top_[t];
+  for (Eigen::SparseMatrix<double>::InnerIterator it(ap, k); it; ++it)
+    if (owner_[static_cast<std::size_t>(it.index())] < 0) y[it.index()] += it.value();
+  const std::int32_t top = top_reach(ap, t, pattern, tags);
+  double d = y[k] * m_shiftScale + m_shiftOffset;
+  y[k] = 0.0;
+  for (const Bin& bin : bins_) d += bin.partial_d[t];
   m_diag[k] = eliminate(k, top, pattern, y, d, [&](std::int32_t i, double& yi) {
     for (const Bin& bin : bins_)
       yi += bin.contributions[t * top_.size() +
@@ -331,9 +336,8 @@ bool TreeLdlt::top_dense(const Eigen::SparseMatrix<double>& ap) {
     ThreadedRegion factoring(timers_, threads > 1);
     if (!dense::cholesky_upper_on_threads(schur_.data(), static_cast<int>(nt))) return false;
   }
-  // Each top row's reach over the top's columns (as top_row_rest), its entries from U.
+  // Each top row's reach over the top's columns (top_reach), its entries from U.
   const auto size = static_cast<std::int32_t>(ap.rows());
-  const int* parent = m_parent.data();
   const int* Lp = m_matrix.outerIndexPtr();
   int* Li = m_matrix.innerIndexPtr();
   double* Lx = m_matrix.valuePtr();
@@ -341,21 +345,7 @@ bool TreeLdlt::top_dense(const Eigen::SparseMatrix<double>& ap) {
   std::vector<std::int32_t> pattern(static_cast<std::size_t>(size)), tags(pattern.size(), -1);
   for (std::size_t t = 0; t < nt; ++t) {
     const std::int32_t k = top_[t];
-    std::int32_t top = size;
-    tags[k] = k;
-    count[k] = 0;
-    const auto reach = [&](std::int32_t i) {
-      for (; tags[i] != k; i = parent[i]) {
-        pattern[--top] = i;
-        tags[i] = k;
-      }
-    };
-    for (Eigen::SparseMatrix<double>::InnerIterator it(ap, k); it; ++it)
-      if (owner_[static_cast<std::size_t>(it.index())] < 0)
-        reach(static_cast<std::int32_t>(it.index()));
-    for (const Bin& bin : bins_)
-      for (std::int32_t s = bin.start_ptr[t]; s < bin.start_ptr[t + 1]; ++s)
-        reach(bin.starts[static_cast<std::size_t>(s)]);
+    std::int32_t top = top_reach(ap, t, pattern.data(), tags.data());
     const double* u = schur_.data() + t * nt;
     for (; top < size; ++top) {
       const std::int32_t i = pattern[top];

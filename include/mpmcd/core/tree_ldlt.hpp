@@ -94,6 +94,10 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
                    double d, const Add& add);
   // Top row t's solve over bin b's columns.
   void top_row_part(const Eigen::SparseMatrix<double>& ap, std::size_t t, std::int32_t b, Bin& bin);
+  // Top row t's reach over the top's columns, in topological order in pattern[returned:]; tags
+  // marks it, and column k = top_[t] of L is emptied.
+  std::int32_t top_reach(const Eigen::SparseMatrix<double>& ap, std::size_t t,
+                         std::int32_t* pattern, std::int32_t* tags);
   // Top row t's solve over the top's columns and D_kk: false if D_kk = 0.
   bool top_row_rest(const Eigen::SparseMatrix<double>& ap, std::size_t t, double* y,
                     std::int32_t* pattern, std::int32_t* tags);
