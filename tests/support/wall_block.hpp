@@ -113,8 +113,10 @@ Vec<Dim> along(int axis, double value) {
 // as wide along the lateral axes with the block shifted by 1.5 mm, starting with the lateral
 // velocity of the quasi-static path at s = 1, v_i = r V (x_i - x_c)/H0 (the linearised
 // sigma11 = 0: r = λ/(λ + 2μ) in plane strain, λ/(2(λ + μ)) in 3D).
-template <int Dim>
-BlockResult squeeze_block(const Squeeze& c) {
+// `after_step(s, model)` is called after every committed step with the exact stretch s (probes of
+// how the state departs).
+template <int Dim, class Observer>
+BlockResult squeeze_block(const Squeeze& c, Observer&& after_step) {
   constexpr int up = Dim - 1;  // the vertical axis
   const auto start = std::chrono::steady_clock::now();
   const double lambda = c.lambda, s_end = c.s_end;
@@ -255,6 +257,7 @@ BlockResult squeeze_block(const Squeeze& c) {
                                     std::max(scale, std::abs(e.sbb)));
     }
     if (worst > 1e-3 && r.lost_at == 1.0) r.lost_at = e.s;
+    after_step(e.s, static_cast<const mpm::Model<Dim>&>(model));
     return true;
   };
   for (int k = 0; k < steps; ++k)
@@ -328,6 +331,12 @@ BlockResult squeeze_block(const Squeeze& c) {
     std::printf("  triaxial b = %.4f: max rel. sigma_yy error = %.2e, back force error = %.2e\n",
                 e.b, r.worst_sigma_yy, r.back_force_error);
   return r;
+}
+
+// The same without an observer.
+template <int Dim>
+BlockResult squeeze_block(const Squeeze& c) {
+  return squeeze_block<Dim>(c, [](double, const mpm::Model<Dim>&) {});
 }
 
 // Runs `all` by `squeeze` without each of the three parts of docs/accuracy.md's diagnosis (walls
