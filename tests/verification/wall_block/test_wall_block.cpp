@@ -322,8 +322,9 @@ TEST(WallBlock, DISABLED_PushedByASecondGrainToHalfItsHeight) {
 // (docs/accuracy.md, "The committed state itself is unstable"). The continuum is stable
 // (tests/reference/interface_stability.py); the mode is the interface's antisymmetric wrinkle
 // (n = 2 across the width), which a dead interface load would release from s = 0.971, and
-// holding the face normals at F^{n+1} over a step's iteration removes its growth to s = 0.71
-// (docs/accuracy.md, "The continuum is stable; the mode is the interface's antisymmetric wrinkle").
+// holding the face normals at F^{n+1} over a step's iteration removes its growth (to s = 0.5
+// with half steps) but loses lambda = 0 near s = 0.56 (docs/accuracy.md, "The continuum is
+// stable; the mode is the interface's antisymmetric wrinkle").
 TEST(WallBlock, PushedByASecondGrainToHalfItsHeightWithTheActiveSetSolver) {
   for (const double lambda : {0.0, 3e6}) {
     const auto r = squeeze(
