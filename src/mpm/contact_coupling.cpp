@@ -85,16 +85,47 @@ Vec<Dim> ImplicitSolver<Dim>::slot_velocity(std::size_t s) const {
 template <int Dim>
 void ImplicitSolver<Dim>::spread_slot_impulses() {
   // Node slots assign (0 + P = P exactly, so runs without face slots keep their bits), face slots
-  // add their weighted impulses.
-  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
-    for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k)
-      work_[slot_ref_[s].first]->P[slot_node_[k]].setZero();
-  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
-    if (!slot_is_face_[s]) work_[slot_ref_[s].first]->P[slot_ref_[s].second] = slot_P_[s];
-  for (std::size_t s = 0; s < slot_ref_.size(); ++s)
-    if (slot_is_face_[s])
-      for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k)
-        work_[slot_ref_[s].first]->P[slot_node_[k]] += slot_weight_[k] * slot_P_[s];
+  // add their weighted impulses. A slot writes only its grain's P, so the grains go on the threads,
+  // each with its slots in ascending order: every node sees the operations of one pass over all
+  // slots in the same order (the same bits on any thread count).
+  const auto ns = static_cast<std::int64_t>(slot_ref_.size());
+  const std::size_t ng = work_.size();
+  if (grain_slots_for_ != ns) {  // counting sort of the slots by grain (stable)
+    grain_slot_start_.assign(ng + 1, 0);
+    for (const auto& ref : slot_ref_) ++grain_slot_start_[static_cast<std::size_t>(ref.first) + 1];
+    for (std::size_t g = 0; g < ng; ++g) grain_slot_start_[g + 1] += grain_slot_start_[g];
+    grain_slots_.resize(static_cast<std::size_t>(ns));
+    std::vector<std::int32_t> fill(grain_slot_start_.begin(), grain_slot_start_.end() - 1);
+    for (std::int64_t s = 0; s < ns; ++s)
+      grain_slots_[static_cast<std::size_t>(
+          fill[static_cast<std::size_t>(slot_ref_[static_cast<std::size_t>(s)].first)]++)] =
+          static_cast<std::int32_t>(s);
+    grain_slots_for_ = ns;
+  }
+  const auto ngi = static_cast<std::int64_t>(ng);
+  const bool threads = ns > 512 && ngi > 1;
+  const ThreadedRegion threaded(&timers_, threads);
+#pragma omp parallel for schedule(dynamic, 4) if (threads)
+  for (std::int64_t gi = 0; gi < ngi; ++gi) {
+    const auto g = static_cast<std::size_t>(gi);
+    const std::int32_t b = grain_slot_start_[g], e = grain_slot_start_[g + 1];
+    if (b == e) continue;
+    std::vector<Vec<Dim>>& P = work_[g]->P;
+    for (std::int32_t i = b; i < e; ++i) {
+      const auto s = static_cast<std::size_t>(grain_slots_[static_cast<std::size_t>(i)]);
+      for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k) P[slot_node_[k]].setZero();
+    }
+    for (std::int32_t i = b; i < e; ++i) {
+      const auto s = static_cast<std::size_t>(grain_slots_[static_cast<std::size_t>(i)]);
+      if (!slot_is_face_[s]) P[slot_ref_[s].second] = slot_P_[s];
+    }
+    for (std::int32_t i = b; i < e; ++i) {
+      const auto s = static_cast<std::size_t>(grain_slots_[static_cast<std::size_t>(i)]);
+      if (slot_is_face_[s])
+        for (std::int32_t k = slot_start_[s]; k < slot_start_[s + 1]; ++k)
+          P[slot_node_[k]] += slot_weight_[k] * slot_P_[s];
+    }
+  }
 }
 
 namespace {

@@ -93,6 +93,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   slot_node_.clear();
   slot_weight_.clear();
   slot_is_face_.clear();
+  grain_slots_for_ = -1;
   slot_key_.clear();
   const auto nn = static_cast<std::size_t>(grid_.node_count());
   if (slot_stamp_.size() != nn) {

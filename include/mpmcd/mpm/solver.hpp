@@ -217,6 +217,10 @@ class ImplicitSolver {
   std::vector<int> slot_rank_;
   bool slot_bases_valid_ = false;  // built for this step's contacts
   std::vector<char> slot_is_face_;
+  // The slots by grain, ascending within each (CSR over grains), for spread_slot_impulses on the
+  // threads; made for `grain_slots_for_` slots of this step (-1: not yet).
+  std::vector<std::int32_t> grain_slot_start_, grain_slots_;
+  std::int64_t grain_slots_for_ = -1;
   // Per slot: warm-start key, the global node of a node slot, -1 - cell of a face slot.
   std::vector<std::int64_t> slot_key_;
   std::vector<std::uint32_t> slot_stamp_;  // per global node: step stamp
