@@ -50,6 +50,39 @@ def moduli(lam, mu, l1, l2):
                 A1212=m / J + s22, A2121=m / J + s11, A1221=m / J, s11=s11, s22=s22)
 
 
+def modes(d, both_signs):
+    """The modes of eq. (3) [-]: per root q (Re q >= 0, and -q too when `both_signs`), with the
+    amplitudes (a, b) from the first row of (3)'s 2x2 system, normalised, and the traction rates
+    dP_12 / sin(kx) and dP_22 / cos(kx) on a face y = const, as (q, a, b, shear, normal)."""
+    c = d['A1122'] + d['A1221']
+    roots = np.roots([d['A1212'] * d['A2222'],
+                      c * c - d['A1212'] * d['A2121'] - d['A1111'] * d['A2222'],
+                      d['A1111'] * d['A2121']])  # eq. (3) in q^2
+    out = []
+    for Q in roots:
+        q0 = np.sqrt(complex(Q))
+        if q0.real < 0:
+            q0 = -q0
+        for q in ((q0, -q0) if both_signs else (q0,)):
+            a, b = c * q, d['A1212'] * q * q - d['A1111']
+            n = np.hypot(abs(a), abs(b))
+            a, b = a / n, b / n
+            out.append((q, a, b, d['A1212'] * q * a - d['A1221'] * b,
+                        d['A1122'] * a + d['A2222'] * q * b))
+    return out
+
+
+def interface_rows(d, a, b, shear, normal, bc):
+    """The two conditions of `bc` at the interface y = 0 for one mode (see boundary_det)."""
+    if bc == 'wall':
+        return shear, b
+    follow_shear = bc in ('follower', 'nominal')
+    follow_normal = bc == 'follower'
+    # dP_12 - p u2,1 = 0 with u2,1 = -b sin; dP_22 + p u1,1 = 0 with u1,1 = a cos (eq. 4)
+    return (shear - (d['s22'] * b if follow_shear else 0),
+            normal - (d['s22'] * a if follow_normal else 0))
+
+
 def boundary_det(lam, mu, l1, l2, bc):
     """Boundary determinant of the half-space y < 0 for the conditions `bc` at y = 0 [-].
 
@@ -57,28 +90,9 @@ def boundary_det(lam, mu, l1, l2, bc):
     the stretch term of dP_22), 'dead' (neither follower term), 'wall' (u2 = 0, dP_12 = 0: the
     mirror mode; a rigid frictionless wall)."""
     d = moduli(lam, mu, l1, l2)
-    c = d['A1122'] + d['A1221']
-    roots = np.roots([d['A1212'] * d['A2222'],
-                      c * c - d['A1212'] * d['A2121'] - d['A1111'] * d['A2222'],
-                      d['A1111'] * d['A2121']])  # eq. (3) in q^2
     M = np.zeros((2, 2), complex)
-    for j, Q in enumerate(roots):
-        q = np.sqrt(complex(Q))
-        if q.real < 0:
-            q = -q
-        a, b = c * q, d['A1212'] * q * q - d['A1111']  # first row of (3)'s 2x2 system
-        n = np.hypot(abs(a), abs(b))
-        a, b = a / n, b / n
-        shear = d['A1212'] * q * a - d['A1221'] * b  # dP_12 / sin(kx)
-        normal = d['A1122'] * a + d['A2222'] * q * b  # dP_22 / cos(kx)
-        if bc == 'wall':
-            M[:, j] = (shear, b)
-        else:
-            follow_shear = bc in ('follower', 'nominal')
-            follow_normal = bc == 'follower'
-            # dP_12 - p u2,1 = 0 with u2,1 = -b sin; dP_22 + p u1,1 = 0 with u1,1 = a cos
-            M[:, j] = (shear - (d['s22'] * b if follow_shear else 0),
-                       normal - (d['s22'] * a if follow_normal else 0))
+    for j, (q, a, b, shear, normal) in enumerate(modes(d, False)):
+        M[:, j] = interface_rows(d, a, b, shear, normal, bc)
     return np.linalg.det(M).real
 
 
@@ -87,27 +101,11 @@ def layer_det(lam, mu, s, kH, bc):
     kH = k H): a rigid frictionless wall at y = -H (u2 = 0, dP_12 = 0) and the interface at y = 0
     with the conditions `bc` of boundary_det [-]."""
     d = moduli(lam, mu, 1.0, s)
-    c = d['A1122'] + d['A1221']
-    roots = np.roots([d['A1212'] * d['A2222'],
-                      c * c - d['A1212'] * d['A2121'] - d['A1111'] * d['A2222'],
-                      d['A1111'] * d['A2121']])
     M = np.zeros((4, 4), complex)
-    j = 0
-    for Q in roots:
-        q0 = np.sqrt(complex(Q))
-        for q in (q0, -q0):  # both decaying and growing with depth in a layer
-            a, b = c * q, d['A1212'] * q * q - d['A1111']
-            n = np.hypot(abs(a), abs(b))
-            a, b = a / n, b / n
-            shear = d['A1212'] * q * a - d['A1221'] * b
-            normal = d['A1122'] * a + d['A2222'] * q * b
-            if bc == 'follower':
-                M[0, j], M[1, j] = shear - d['s22'] * b, normal - d['s22'] * a
-            else:  # dead
-                M[0, j], M[1, j] = shear, normal
-            e = np.exp(-q * kH)
-            M[2, j], M[3, j] = shear * e, b * e
-            j += 1
+    # both decaying and growing with depth in a layer
+    for j, (q, a, b, shear, normal) in enumerate(modes(d, True)):
+        e = np.exp(-q * kH)
+        M[:, j] = (*interface_rows(d, a, b, shear, normal, bc), shear * e, b * e)
     return np.linalg.det(M).real
 
 
