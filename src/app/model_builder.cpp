@@ -456,6 +456,7 @@ mpm::Settings<Dim> build_settings(const io::Config& cfg, const mpm::Model<Dim>& 
   c.gap_horizon = cfg.contact.gap_horizon;
   c.wall_points = cfg.contact.wall_contact == "points";
   c.grain_faces = cfg.contact.grain_contact == "faces";
+  c.face_normals_at_end = cfg.contact.face_normals == "end";
   c.active_set = cfg.contact.solver == "active_set";
   // Delassus operator: the lumped 1/m_I is accurate when inertia dominates a step (theta c_p dt/h
   // small); otherwise each grain's exact compliance (needs a direct solver) keeps the staggered

@@ -34,6 +34,17 @@ void face_corners(const Vec<Dim>& x, const Mat<Dim>& D, int axis, double sign,
 }
 
 template <int Dim>
+Vec<Dim> face_normal(const Mat<Dim>& D, int axis, double sign) {
+  const Vec<Dim> m = D.inverse().row(axis).transpose();
+  return sign * m / m.norm();
+}
+
+template <int Dim>
+Mat<Dim> face_normal_derivative(const Vec<Dim>& n, const Vec<Dim>& g) {
+  return -(g - n * n.dot(g)) * n.transpose();
+}
+
+template <int Dim>
 Vec<Dim> face_toward(const Vec<Dim>& x, const Mat<Dim>& D, const Vec<Dim>& n,
                      std::vector<Vec<Dim>>& corners) {
   // Choosing the corners that minimise s . D^T n instead would switch from a face to a single
@@ -218,6 +229,8 @@ bool corner_weights(const NodeBoxView<Dim>& box, std::span<const Vec<Dim>> corne
   template double domain_extent<D>(const Mat<D>&, const Mat<D>&, const Vec<D>&);                  \
   template double domain_reach<D>(const Mat<D>&);                                                 \
   template void face_corners<D>(const Vec<D>&, const Mat<D>&, int, double, std::vector<Vec<D>>&); \
+  template Vec<D> face_normal<D>(const Mat<D>&, int, double);                                     \
+  template Mat<D> face_normal_derivative<D>(const Vec<D>&, const Vec<D>&);                        \
   template Vec<D> face_toward<D>(const Vec<D>&, const Mat<D>&, const Vec<D>&,                     \
                                  std::vector<Vec<D>>&);                                           \
   template double pair_gap<D>(const DomainsView<D>&, std::int64_t, std::int64_t);                 \

@@ -76,6 +76,14 @@ void add_interaction_tables(Schema& s) {
                        "the step. 0: every face within `wall_range` cells (docs/contact.md)")
            .at_least(0.0)
            .default_of_member(),
+       KeySpec::string("face_normals", &ContactSection::face_normals,
+                       "grain_contact = \"faces\": the normal of each face contact, \"end\" (the "
+                       "face's normal at the Newton iterate's end-of-step configuration, with its "
+                       "geometric stiffness in the grain's Newton matrix: the interface pressure "
+                       "follows the faces as they turn) or \"start\" (the face's normal at the "
+                       "start of the step, held through it); docs/contact.md")
+           .one_of({"end", "start"})
+           .default_of_member(),
        KeySpec::string("wall_contact", &ContactSection::wall_contact,
                        "where a wall acts: \"nodes\" (a grain node's velocity may not cross "
                        "it) or \"points\" (the velocity of each point domain's face toward it, "

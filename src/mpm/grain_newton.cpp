@@ -14,6 +14,48 @@
 
 namespace mpmcd::mpm {
 
+template <int Dim>
+void nodal_residual(GrainField<Dim>& w, const Settings<Dim>& settings, double dt) {
+  const std::size_t na = w.m.size();
+  const double theta = settings.theta;
+  // Residual R_I = m_I (v^{n+1} - v^n) - dt [(1 - theta) f^n + theta f^{n+1}] (method.md §2).
+  // Reference scale: inertia, nodal forces and the magnitude of the stress contributions, so that
+  // the tolerance stays above round-off when large point forces cancel at a node.
+  double r2 = 0, mv2 = 0, fn2 = 0, fi2 = 0, fe2 = 0, fa2 = 0, p2 = 0;
+  for (std::size_t a = 0; a < na; ++a) {
+    // ... - P_I: the contact impulse over the step (method.md §2, §4)
+    Vec<Dim> r = w.m[a] * (w.v[a] - w.v_n[a]) -
+                 dt * ((1.0 - theta) * w.f_n[a] + theta * (w.f_int[a] + w.f_ext[a])) - w.P[a];
+    for (int d = 0; d < Dim; ++d)
+      if (w.mask[a] & (1u << d)) r[d] = 0.0;
+    w.R[a] = r;
+    r2 += r.squaredNorm();
+    mv2 += (w.m[a] * w.v_n[a]).squaredNorm();
+    fn2 += w.f_n[a].squaredNorm();
+    fi2 += w.f_int[a].squaredNorm();
+    fe2 += w.f_ext[a].squaredNorm();
+    fa2 += w.f_abs[a].squaredNorm();
+    p2 += w.P[a].squaredNorm();
+  }
+  w.res_norm = std::sqrt(r2);
+  w.res_ref = std::sqrt(mv2) + std::sqrt(p2) +
+              dt * (std::sqrt(fn2) + std::sqrt(fi2) + std::sqrt(fe2) + std::sqrt(fa2));
+  if (!std::isfinite(w.res_norm)) {
+    w.failure = "non-finite residual";
+    return;
+  }
+  // Velocity scale of the increment test (mass norm): sqrt(sum m max(|v^{n+1}|^2, |v^n|^2)) plus
+  // the velocity change the step's forces and impulses can produce, res_ref / sqrt(M) (a body at
+  // rest has no velocity scale of its own). The convergence decision is the caller's
+  // (ImplicitSolver::solve_step).
+  double vref2 = 0, mass = 0;
+  for (std::size_t a = 0; a < na; ++a) {
+    vref2 += w.m[a] * std::max(w.v[a].squaredNorm(), w.v_n[a].squaredNorm());
+    mass += w.m[a];
+  }
+  w.vel_ref = std::sqrt(vref2) + (mass > 0 ? w.res_ref / std::sqrt(mass) : 0.0);
+}
+
 template <class S1, int Dim>
 void evaluate(GrainField<Dim>& w, TrialState<Dim>& trial, const Settings<Dim>& settings,
               const points::PointSet<Dim>& points, const points::Grain& gr,
@@ -77,42 +119,8 @@ void evaluate(GrainField<Dim>& w, TrialState<Dim>& trial, const Settings<Dim>& s
       w.f_abs[n] += fa.cwiseAbs();
     }
   }
-  // Residual R_I = m_I (v^{n+1} - v^n) - dt [(1 - theta) f^n + theta f^{n+1}] (method.md §2).
-  // Reference scale: inertia, nodal forces and the magnitude of the stress contributions, so that
-  // the tolerance stays above round-off when large point forces cancel at a node.
-  double r2 = 0, mv2 = 0, fn2 = 0, fi2 = 0, fe2 = 0, fa2 = 0, p2 = 0;
-  for (std::size_t a = 0; a < na; ++a) {
-    // ... - P_I: the contact impulse over the step (method.md §2, §4)
-    Vec<Dim> r = w.m[a] * (w.v[a] - w.v_n[a]) -
-                 dt * ((1.0 - theta) * w.f_n[a] + theta * (w.f_int[a] + w.f_ext[a])) - w.P[a];
-    for (int d = 0; d < Dim; ++d)
-      if (w.mask[a] & (1u << d)) r[d] = 0.0;
-    w.R[a] = r;
-    r2 += r.squaredNorm();
-    mv2 += (w.m[a] * w.v_n[a]).squaredNorm();
-    fn2 += w.f_n[a].squaredNorm();
-    fi2 += w.f_int[a].squaredNorm();
-    fe2 += w.f_ext[a].squaredNorm();
-    fa2 += w.f_abs[a].squaredNorm();
-    p2 += w.P[a].squaredNorm();
-  }
-  w.res_norm = std::sqrt(r2);
-  w.res_ref = std::sqrt(mv2) + std::sqrt(p2) +
-              dt * (std::sqrt(fn2) + std::sqrt(fi2) + std::sqrt(fe2) + std::sqrt(fa2));
-  if (!std::isfinite(w.res_norm)) {
-    w.failure = "non-finite residual";
-    return;
-  }
-  // Velocity scale of the increment test (mass norm): sqrt(sum m max(|v^{n+1}|^2, |v^n|^2)) plus
-  // the velocity change the step's forces and impulses can produce, res_ref / sqrt(M) (a body at
-  // rest has no velocity scale of its own). The convergence decision is the caller's
-  // (ImplicitSolver::solve_step).
-  double vref2 = 0, mass = 0;
-  for (std::size_t a = 0; a < na; ++a) {
-    vref2 += w.m[a] * std::max(w.v[a].squaredNorm(), w.v_n[a].squaredNorm());
-    mass += w.m[a];
-  }
-  w.vel_ref = std::sqrt(vref2) + (mass > 0 ? w.res_ref / std::sqrt(mass) : 0.0);
+  nodal_residual(w, settings, dt);
+  if (!w.failure.empty()) return;
   w.evaluated = true;
 }
 
@@ -177,6 +185,8 @@ void assemble_tangent(GrainField<Dim>& w, const TrialState<Dim>& trial,
       }
     }
   }
+  if (!w.follower_K.empty())
+    for (std::size_t k = 0; k < w.K_blk.size(); ++k) w.K_blk[k] += w.follower_K[k];
   w.tangent_current = true;
 }
 
@@ -347,6 +357,7 @@ void newton_solve(GrainField<Dim>& w, const TrialState<Dim>& trial, const Settin
                                         const points::PointSet<D>&, const points::Grain&);
 #define MPMCD_INSTANTIATE(D)                                                                    \
   MPMCD_FOR_EACH_SHAPE(MPMCD_INSTANTIATE_SHAPE, D)                                              \
+  template void nodal_residual<D>(GrainField<D>&, const Settings<D>&, double);                  \
   template bool factorize<D>(GrainField<D>&, const Settings<D>&, double);                       \
   template bool prepare_factor<D>(GrainField<D>&, const TrialState<D>&, const Settings<D>&,     \
                                   const points::PointSet<D>&, const points::Grain&,             \

@@ -128,11 +128,13 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
     exchange_entries();  // the ghost grains' contact nodes (none on one rank)
     ScopedStage t(&timers_, "contact.detect");
     detect_contacts(dt);
+    prepare_face_normals();
     comm_->count_work(parallel::cost::kDetectItem * detect_items_);
     exchange_requests();  // the ghost slots' links, and whether any rank has contacts
   } else {
     problem_.contacts.clear();
     problem_.slots.clear();
+    face_normals_.clear();
     have_contacts_ = false;
   }
   double impulse_change = 0, ref_scale = 0, vel_scale = 0;
@@ -172,6 +174,8 @@ StepStats ImplicitSolver<Dim>::solve_step(double dt) {
         return static_cast<double>(gr.size());
       });
     }
+    // Face contacts' normals at this iterate's F^{n+1} (face_normals_at_end; none otherwise).
+    if (have_contacts_ && !local_failure()) follow_face_normals();
     const bool failed_here = local_failure();
     // Convergence of each evaluated grain: |R| <= tol * reference and |dv|_M <= tol * velocity
     // scale, the references floored at 1e-3 of the largest grain's so that a grain at rest (whose

@@ -94,6 +94,9 @@ struct Squeeze {
   bool two_grains = false, grain_faces = true;
   // true: contact problems solved by block principal pivoting (contact.solver = "active_set")
   bool active_set = false;
+  // true: the grain-grain face contacts' normals at the iterate's F^{n+1}, with their stiffness
+  // (contact.face_normals = "end")
+  bool face_normals_at_end = false;
   // The block [lo, hi]^Dim [m] on a grid of cell size h [m] (lo, hi multiples of h), 2 points per
   // cell and axis
   double h = 1e-4, lo = 5e-4, hi = 1.5e-3;
@@ -160,6 +163,7 @@ BlockResult squeeze_block(const Squeeze& c, Observer&& after_step) {
   s.contact.wall_points = c.wall_points;
   s.contact.grain_faces = c.grain_faces;
   s.contact.active_set = c.active_set;
+  s.contact.face_normals_at_end = c.face_normals_at_end;
   s.contact.gs.tolerance = 1e-12;
   s.contact.impulse_tolerance = c.impulse_tolerance;
   // bottom, top, left, right (x), then in 3D front, back (y)

@@ -38,6 +38,19 @@ template <int Dim>
 void face_corners(const Vec<Dim>& x, const Mat<Dim>& D, int axis, double sign,
                   std::vector<Vec<Dim>>& corners);
 
+/// Outward unit normal of the face s_axis = sign (sign = +-1) of the domain x + D s: the row
+/// `axis` of D^-1 (m = D^-T e_axis), times sign / |m|, as grain_face_contacts takes it [-].
+template <int Dim>
+Vec<Dim> face_normal(const Mat<Dim>& D, int axis, double sign);
+
+/// Derivative of a face's unit normal n (face_normal of D = dF D^n) with respect to the
+/// increment du_J of one grid node J, when dF = I + sum_J du_J (x) grad N_J(x^n) moves the
+/// domain: dn = -(I - n n^T) g_J (n . du_J), so the Dim x Dim matrix -(I - n n^T) g_J n^T, with
+/// g_J = dF^-T grad N_J(x^n) the node's shape gradient at x^{n+1} [1/m] (exact, from
+/// d(dF^-T) = -dF^-T d(dF)^T dF^-T; docs/contact.md, "Face normals at the end of the step").
+template <int Dim>
+Mat<Dim> face_normal_derivative(const Vec<Dim>& n, const Vec<Dim>& g);
+
 /// The face of the domain x + D s facing a wall of unit normal n (into the domain): s_k =
 /// -sign(m_k . n) on the axis k whose face normal m_k = D^-T e_k is the most nearly parallel to n,
 /// whatever the domain's small shear or rotation. Appends its corners (face_corners) and returns

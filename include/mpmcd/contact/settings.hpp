@@ -43,6 +43,12 @@ struct ContactSettings {
   /// largest speed (grain nodes, walls) plus |gravity| dt, i.e. if it could close within
   /// gap_horizon steps; 0: every face within wall_range cells [-].
   double gap_horizon = 4.0;
+  /// With grain_faces: true = each grain-grain face contact's normal is its face's normal at the
+  /// Newton iterate's F^{n+1}, updated every iteration, with the symmetric part of its
+  /// derivative (the interface pressure's geometric stiffness) in the face grain's Newton matrix;
+  /// false = the face's normal at F^n, held through the step (docs/contact.md, "Face normals at
+  /// the end of the step").
+  bool face_normals_at_end = false;
   GsSettings gs;  ///< Gauss-Seidel tolerance and sweep limit
   /// Solve each contact problem by block principal pivoting on the normal impulses
   /// (solve_active_set, frictionless problems, one MPI rank) instead of Gauss-Seidel.

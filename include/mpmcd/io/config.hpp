@@ -137,6 +137,8 @@ struct ContactSection {
   double impulse_tolerance = 1e-6;  ///< relative impulse change between Newton iterations [-]
   double wall_range = 1.0;          ///< grain nodes within this many cells of a wall take part [-]
   double gap_horizon = 4.0;  ///< steps within which a grain face's gap must be able to close [-]
+  std::string face_normals =
+      "start";  ///< grain faces' normals: "end" (at F^{n+1}) or "start" (F^n)
   std::string wall_contact = "nodes";     ///< where walls act: "nodes" or "points" (point faces)
   std::string grain_contact = "nodes";    ///< where grains meet: "nodes" or "faces" (point faces)
   std::string solver = "gauss_seidel";    ///< contact solver: "gauss_seidel" or "active_set" [-]

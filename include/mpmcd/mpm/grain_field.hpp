@@ -153,15 +153,18 @@ struct GrainField {
   double vel_ref = 0;               ///< velocity scale of the increment test [sqrt(kg) m/s]
   bool evaluated = false;           ///< residual evaluated in the current Newton iteration
   std::vector<IVec<Dim>> pt_first;  ///< per point: first support node (grid coordinates)
-  std::vector<std::int32_t> pt_node;      ///< per point x K: active node or -1
-  std::vector<double> pt_N;               ///< per point x K: weights at x^n [-]
-  std::vector<Vec<Dim>> pt_dN;            ///< per point x K: gradients at x^n [1/m]
-  int K = 0;                              ///< support size [-]
-  int S = 0;                              ///< stencil size [-]
-  int radius = 0;                         ///< stencil radius [nodes]
-  std::vector<std::int32_t> pair_slot;    ///< K x K: stencil slot of node b seen from node a
-  std::vector<std::int32_t> stencil_nb;   ///< active x S: neighbour active node or -1
-  std::vector<Mat<Dim>> K_blk;            ///< active x S: tangent blocks K_ab [N/m]
+  std::vector<std::int32_t> pt_node;     ///< per point x K: active node or -1
+  std::vector<double> pt_N;              ///< per point x K: weights at x^n [-]
+  std::vector<Vec<Dim>> pt_dN;           ///< per point x K: gradients at x^n [1/m]
+  int K = 0;                             ///< support size [-]
+  int S = 0;                             ///< stencil size [-]
+  int radius = 0;                        ///< stencil radius [nodes]
+  std::vector<std::int32_t> pair_slot;   ///< K x K: stencil slot of node b seen from node a
+  std::vector<std::int32_t> stencil_nb;  ///< active x S: neighbour active node or -1
+  std::vector<Mat<Dim>> K_blk;           ///< active x S: tangent blocks K_ab [N/m]
+  /// active x S: blocks added to K_blk at each assembly (the face contacts' normal stiffness,
+  /// ImplicitSolver::follow_face_normals; empty: none) [N/m]
+  std::vector<Mat<Dim>> follower_K;
   SpMat A;                                ///< Newton matrix M + theta^2 dt^2 K [kg]
   std::vector<std::int64_t> value_index;  ///< (active x S x Dim x Dim) -> A.valuePtr() index
   SparseLdlt ldlt;                        ///< LDL^T factorisation (LinearSolverKind::kLdlt)
@@ -213,8 +216,14 @@ void evaluate(GrainField<Dim>& w, TrialState<Dim>& trial, const Settings<Dim>& s
               const points::PointSet<Dim>& points, const points::Grain& grain,
               const materials::Law<Dim>& law, double dt);
 
+/// The residual R = M (v - v^n) - dt [(1 - theta) f^n + theta f^{n+1}] - P of the grain's nodes
+/// from the forces of the last evaluate and the current impulses P, and its scales (evaluate's
+/// last part; again after the impulses change with the same F) [s].
+template <int Dim>
+void nodal_residual(GrainField<Dim>& w, const Settings<Dim>& settings, double dt);
+
 /// The tangent blocks K_IJ = sum V g_I a g_J at the last evaluate (K = -d f_int / d du; the
-/// projected point tangents when w.project_tangent).
+/// projected point tangents when w.project_tangent), plus follower_K when it is not empty.
 template <class S1, int Dim>
 void assemble_tangent(GrainField<Dim>& w, const TrialState<Dim>& trial,
                       const points::PointSet<Dim>& points, const points::Grain& grain);

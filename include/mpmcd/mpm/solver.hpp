@@ -171,6 +171,19 @@ class ImplicitSolver {
                             std::vector<double>& dv2);
   // Nodal impulses of every grain from the slots' impulses slot_P_: P_a = sum_s w_sa P_s.
   void spread_slot_impulses();
+  // With ContactSettings::face_normals_at_end: the step's grain-grain face contacts, each with
+  // its face (point, axis, side) and the K_blk positions of the (I, J) blocks of its normal's
+  // stiffness in the face grain's Newton matrix (face_normals.cpp); made after detection.
+  void prepare_face_normals();
+  // contact.follow: each grain-grain face contact's normal from the iterate's F^{n+1} (its
+  // impulse turned with it), the grains' nodal impulses and residuals again, and the symmetric
+  // part of the normal's stiffness into each face grain's follower_K (docs/contact.md, "Face
+  // normals at the end of the step").
+  void follow_face_normals();
+  // follow_face_normals' parts: the slots' and grains' impulses and residuals after the normals
+  // turned; the normals' stiffness into follower_K.
+  void follow_impulses();
+  void follow_stiffness();
   // Agrees on the lowest failing grain over the ranks (reduced here when `lowest` < 0, else that
   // grain) and gives every rank its owner's failure message; false when no rank failed.
   bool sync_failure(StepStats& stats, std::int64_t lowest = -1);
@@ -217,6 +230,25 @@ class ImplicitSolver {
   std::vector<int> slot_rank_;
   bool slot_bases_valid_ = false;  // built for this step's contacts
   std::vector<char> slot_is_face_;
+  // prepare_face_normals: per grain-grain face contact (grouped by the face's grain, CSR
+  // face_start_ over grains) its contact, point, axis and side, and its stiffness blocks: slot
+  // entry q of its face slot (node I, weight w), window entry a of the point (node J), and the
+  // K_blk indices of (I, J) and (J, I).
+  struct FaceNormal {
+    std::int32_t contact;
+    std::int64_t point;
+    int axis;
+    double sign;
+    std::int32_t first_block, end_block;
+  };
+  struct FaceBlock {
+    std::int32_t q, a;
+    std::int64_t ij, ji;
+  };
+  std::vector<FaceNormal> face_normals_;
+  std::vector<Vec<Dim>> follow_normal_;  // per face_normals_ entry: its normal at the iterate
+  std::vector<FaceBlock> face_blocks_;
+  std::vector<std::int32_t> face_start_;
   // The slots by grain, ascending within each (CSR over grains), for spread_slot_impulses on the
   // threads; made for `grain_slots_for_` slots of this step (-1: not yet).
   std::vector<std::int32_t> grain_slot_start_, grain_slots_;
