@@ -129,26 +129,28 @@ void ImplicitSolver<Dim>::follow_impulses() {
   // impulses changed is reopened by the contact solve's response (impulses_changed).
   slot_P_ = contact::net_impulses(problem_);
   spread_slot_impulses();
+  on_live_grains([&](std::size_t, GrainWork& w) {
+    if (!w.slots.empty()) nodal_residual(w, settings_, dt_);
+  });
+}
+
+template <int Dim>
+template <class Fn>
+void ImplicitSolver<Dim>::on_live_grains(Fn&& fn) {
   const auto ng = static_cast<std::int64_t>(work_.size());
   const ThreadedRegion threaded(&timers_, ng > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
   for (std::int64_t gi = 0; gi < ng; ++gi) {
     const auto g = static_cast<std::size_t>(gi);
     GrainWork& w = *work_[g];
-    if (role_[g] == 1 && !w.slots.empty() && w.failure.empty()) nodal_residual(w, settings_, dt_);
+    if (role_[g] == 1 && w.failure.empty()) fn(g, w);
   }
 }
 
 template <int Dim>
 void ImplicitSolver<Dim>::follow_stiffness() {
   const double dt = dt_;
-  const auto ng = static_cast<std::int64_t>(work_.size());
-  const ThreadedRegion threaded(&timers_, ng > 1);
-#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
-  for (std::int64_t gi = 0; gi < ng; ++gi) {
-    const auto g = static_cast<std::size_t>(gi);
-    GrainWork& w = *work_[g];
-    if (role_[g] != 1 || !w.failure.empty()) continue;
+  on_live_grains([&](std::size_t g, GrainWork& w) {
     // 3. The normal's stiffness: the face's impulse -p n on grain X at its slot's nodes I
     // (weights w_I) turns with the face, dn = -(I - n n^T) g_J (n . du_J) for du_J = theta dt
     // dv_J (face_normal_derivative), so the residual's derivative (method.md §2) gains
@@ -157,7 +159,7 @@ void ImplicitSolver<Dim>::follow_stiffness() {
     // other grain, and the unsymmetric rest, are left to the staggered iterations
     // (docs/contact.md).
     const std::int32_t f0 = face_start_[g], f1 = face_start_[g + 1];
-    if (f0 == f1) continue;
+    if (f0 == f1) return;
     w.follower_K.assign(w.K_blk.size(), Mat<Dim>::Zero());
     const double scale = 0.5 / (settings_.theta * dt);
     const std::int64_t begin = grains_[g].begin;
@@ -177,7 +179,7 @@ void ImplicitSolver<Dim>::follow_stiffness() {
         w.follower_K[static_cast<std::size_t>(fb.ji)] += B.transpose();
       }
     }
-  }
+  });
 }
 
 // The members defined here (the class is instantiated in solver.cpp).

@@ -184,6 +184,9 @@ class ImplicitSolver {
   // turned; the normals' stiffness into follower_K.
   void follow_impulses();
   void follow_stiffness();
+  // Runs fn(g, work) on the threads for each grain this rank owns that has not failed.
+  template <class Fn>
+  void on_live_grains(Fn&& fn);
   // Agrees on the lowest failing grain over the ranks (reduced here when `lowest` < 0, else that
   // grain) and gives every rank its owner's failure message; false when no rank failed.
   bool sync_failure(StepStats& stats, std::int64_t lowest = -1);
