@@ -26,18 +26,18 @@ constexpr int kMaxProximalSteps = 30;
 constexpr int kPreSweeps = 1;
 }  // namespace
 
+namespace {
+
+// The normal system's parts (normal_system): b, p, and W's columns from the resources the
+// contacts share. A contact's relative normal velocity n_c . (v_B - v_A) responds to impulses
+// through the slots it shares with other contacts: those of one compliance group (G blocks) or
+// one lumped slot (I / m). Each such resource lists its (contact, slot, sign) entries; every pair
+// of entries adds sign_e sign_f n_e . R(slot_e, slot_f) n_f to W (method.md §4). In a group,
+// n_e . G_ef n_f = nu_e . Gr_ef nu_f with nu = B^T n the normal on the slot's directions
+// (contact::Group), kept in the entry with its rows of Gr.
 template <int Dim>
-NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix, StageTimers* timers) {
-  const auto m = static_cast<Eigen::Index>(p.contacts.size());
-  NormalSystem sys;
-  sys.b.resize(m);
-  sys.p.resize(m);
-  // A contact's relative normal velocity n_c . (v_B - v_A) responds to impulses through the
-  // slots it shares with other contacts: those of one compliance group (G blocks) or one lumped
-  // slot (I / m). Each such resource lists its (contact, slot, sign) entries; every pair of
-  // entries adds sign_e sign_f n_e . R(slot_e, slot_f) n_f to W (method.md §4). In a group,
-  // n_e . G_ef n_f = nu_e . Gr_ef nu_f with nu = B^T n the normal on the slot's directions
-  // (contact::Group), kept in the entry with its rows of Gr.
+class NormalColumns {
+ public:
   struct Entry {
     std::int32_t contact, slot;
     double sign;
@@ -45,66 +45,32 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix, StageTimers*
     Eigen::Index col = 0;          // the slot's first row of Gr
     std::array<double, Dim> nu{};  // B^T n of the contact's normal [-]
   };
-  const std::size_t ng = p.groups.size();
-  std::vector<std::vector<Entry>> by_resource(ng + p.slots.size());
-  const auto resource = [&](std::int32_t s) {
-    return p.slots[s].group >= 0 ? static_cast<std::size_t>(p.slots[s].group)
-                                 : ng + static_cast<std::size_t>(s);
-  };
-  const auto entry = [&](std::int32_t c, std::int32_t s, double sign) {
-    Entry e{c, s, sign};
-    const Slot<Dim>& sl = p.slots[s];
-    if (sl.group < 0) return e;
-    const Group<Dim>& g = p.groups[sl.group];
-    const auto j = static_cast<std::size_t>(sl.local);
-    e.rank = g.rank(j);
-    e.col = g.col[j];
-    for (int m = 0; m < e.rank; ++m)
-      e.nu[m] = g.basis[j].col(m).dot(p.contacts[static_cast<std::size_t>(c)].normal);
-    return e;
-  };
-  for (Eigen::Index c = 0; c < m; ++c) {
-    const Contact<Dim>& k = p.contacts[static_cast<std::size_t>(c)];
-    const Vec<Dim> va = k.a >= 0 ? p.slots[k.a].v_free : k.wall_velocity;
-    sys.b[c] = k.normal.dot(p.slots[k.b].v_free - va) + k.gap / p.dt;
-    sys.p[c] = k.impulse.dot(k.normal);
-    if (!with_matrix) continue;
-    const auto ci = static_cast<std::int32_t>(c);
-    by_resource[resource(k.b)].push_back(entry(ci, k.b, 1.0));
-    if (k.a >= 0) by_resource[resource(k.a)].push_back(entry(ci, k.a, -1.0));
+
+  // b and p of `sys` (sized here); with `with_matrix` also the resources' entry lists.
+  NormalColumns(const Problem<Dim>& p, bool with_matrix, NormalSystem& sys)
+      : p_(p), ng_(p.groups.size()) {
+    const auto m = static_cast<Eigen::Index>(p.contacts.size());
+    sys.b.resize(m);
+    sys.p.resize(m);
+    if (with_matrix) by_resource_.resize(ng_ + p.slots.size());
+    for (Eigen::Index c = 0; c < m; ++c) {
+      const Contact<Dim>& k = p.contacts[static_cast<std::size_t>(c)];
+      const Vec<Dim> va = k.a >= 0 ? p.slots[k.a].v_free : k.wall_velocity;
+      sys.b[c] = k.normal.dot(p.slots[k.b].v_free - va) + k.gap / p.dt;
+      sys.p[c] = k.impulse.dot(k.normal);
+      if (!with_matrix) continue;
+      const auto ci = static_cast<std::int32_t>(c);
+      by_resource_[resource(k.b)].push_back(entry(ci, k.b, 1.0));
+      if (k.a >= 0) by_resource_[resource(k.a)].push_back(entry(ci, k.a, -1.0));
+    }
   }
-  if (!with_matrix) return sys;
-  // W column by column on the threads, straight into compressed storage: column c gathers the
-  // entries of the one or two resources of its slots, whose lists are in ascending contact
-  // order, merged (a contact sharing both resources with c gets both terms, added). A first
-  // pass counts each column's rows. f is column c's own entry in the resource.
-  const auto value = [&](std::size_t r, const Entry& e, const Entry& f) {
-    if (r >= ng) {  // lumped: R = I / m
-      const Vec<Dim>& ne = p.contacts[static_cast<std::size_t>(e.contact)].normal;
-      const Vec<Dim>& nf = p.contacts[static_cast<std::size_t>(f.contact)].normal;
-      return e.sign * f.sign * ne.dot(nf) / p.slots[f.slot].mass;
-    }
-    const Eigen::MatrixXd& Gr = p.groups[r].Gr;
-    double acc = 0;
-    for (int n = 0; n < f.rank; ++n) {
-      const double* col = Gr.data() + (f.col + n) * Gr.rows() + e.col;
-      double row = 0;
-      for (int m = 0; m < e.rank; ++m) row += e.nu[m] * col[m];
-      acc += row * f.nu[n];
-    }
-    return e.sign * f.sign * acc;
-  };
-  static const std::vector<Entry> kNone;
-  const auto lists = [&](const Contact<Dim>& k) {
-    return std::pair<const std::vector<Entry>*, const std::vector<Entry>*>(
-        &by_resource[resource(k.b)], k.a >= 0 ? &by_resource[resource(k.a)] : &kNone);
-  };
-  std::vector<Eigen::Index> count(static_cast<std::size_t>(m) + 1, 0);
-  const bool threads = ng > 1;
-  ThreadedRegion counting(timers, threads);
-#pragma omp parallel for schedule(dynamic, 64) if (threads)
-  for (Eigen::Index c = 0; c < m; ++c) {
-    const auto [l1, l2] = lists(p.contacts[static_cast<std::size_t>(c)]);
+
+  // The group of slot s's resource, or -1 for a lumped slot [-].
+  std::int64_t group_of(std::int32_t s) const { return p_.slots[s].group; }
+
+  // Column c's row count (the merge of its one or two resources' lists) [-].
+  std::size_t count(Eigen::Index c) const {
+    const auto [l1, l2] = lists(p_.contacts[static_cast<std::size_t>(c)]);
     std::size_t i = 0, j = 0, n = 0;
     while (i < l1->size() || j < l2->size()) {
       const std::int32_t r1 = i < l1->size() ? (*l1)[i].contact : std::numeric_limits<int>::max();
@@ -113,8 +79,90 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix, StageTimers*
       j += r2 <= r1;
       ++n;
     }
-    count[static_cast<std::size_t>(c) + 1] = static_cast<Eigen::Index>(n);
+    return n;
   }
+
+  // Writes column c's rows and values from `out` on: the entries of its resources' lists, which
+  // are in ascending contact order, merged (a contact sharing both resources with c gets both
+  // terms, added).
+  void fill(Eigen::Index c, int* rows, double* vals) const {
+    const Contact<Dim>& k = p_.contacts[static_cast<std::size_t>(c)];
+    const auto [l1, l2] = lists(k);
+    const std::size_t r1 = resource(k.b), r2 = k.a >= 0 ? resource(k.a) : 0;
+    const auto ci = static_cast<std::int32_t>(c);
+    const Entry f1 = entry(ci, k.b, 1.0), f2 = k.a >= 0 ? entry(ci, k.a, -1.0) : Entry{};
+    std::size_t i = 0, j = 0, out = 0;
+    while (i < l1->size() || j < l2->size()) {
+      const std::int32_t c1 = i < l1->size() ? (*l1)[i].contact : std::numeric_limits<int>::max();
+      const std::int32_t c2 = j < l2->size() ? (*l2)[j].contact : std::numeric_limits<int>::max();
+      double v = 0;
+      if (c1 <= c2) v += value(r1, (*l1)[i++], f1);
+      if (c2 <= c1) v += value(r2, (*l2)[j++], f2);
+      rows[out] = std::min(c1, c2);
+      vals[out++] = v;
+    }
+  }
+
+ private:
+  std::size_t resource(std::int32_t s) const {
+    return p_.slots[s].group >= 0 ? static_cast<std::size_t>(p_.slots[s].group)
+                                  : ng_ + static_cast<std::size_t>(s);
+  }
+  Entry entry(std::int32_t c, std::int32_t s, double sign) const {
+    Entry e{c, s, sign};
+    const Slot<Dim>& sl = p_.slots[s];
+    if (sl.group < 0) return e;
+    const Group<Dim>& g = p_.groups[sl.group];
+    const auto j = static_cast<std::size_t>(sl.local);
+    e.rank = g.rank(j);
+    e.col = g.col[j];
+    for (int m = 0; m < e.rank; ++m)
+      e.nu[m] = g.basis[j].col(m).dot(p_.contacts[static_cast<std::size_t>(c)].normal);
+    return e;
+  }
+  // f is column c's own entry in resource r.
+  double value(std::size_t r, const Entry& e, const Entry& f) const {
+    if (r >= ng_) {  // lumped: R = I / m
+      const Vec<Dim>& ne = p_.contacts[static_cast<std::size_t>(e.contact)].normal;
+      const Vec<Dim>& nf = p_.contacts[static_cast<std::size_t>(f.contact)].normal;
+      return e.sign * f.sign * ne.dot(nf) / p_.slots[f.slot].mass;
+    }
+    const Eigen::MatrixXd& Gr = p_.groups[r].Gr;
+    double acc = 0;
+    for (int n = 0; n < f.rank; ++n) {
+      const double* col = Gr.data() + (f.col + n) * Gr.rows() + e.col;
+      double row = 0;
+      for (int m = 0; m < e.rank; ++m) row += e.nu[m] * col[m];
+      acc += row * f.nu[n];
+    }
+    return e.sign * f.sign * acc;
+  }
+  std::pair<const std::vector<Entry>*, const std::vector<Entry>*> lists(
+      const Contact<Dim>& k) const {
+    return {&by_resource_[resource(k.b)], k.a >= 0 ? &by_resource_[resource(k.a)] : &none_};
+  }
+  const Problem<Dim>& p_;
+  std::size_t ng_;
+  std::vector<std::vector<Entry>> by_resource_;
+  std::vector<Entry> none_;
+};
+
+}  // namespace
+
+template <int Dim>
+NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix, StageTimers* timers) {
+  const auto m = static_cast<Eigen::Index>(p.contacts.size());
+  NormalSystem sys;
+  const NormalColumns<Dim> cols(p, with_matrix, sys);
+  if (!with_matrix) return sys;
+  // W column by column on the threads, straight into compressed storage; a first pass counts
+  // each column's rows.
+  std::vector<Eigen::Index> count(static_cast<std::size_t>(m) + 1, 0);
+  const bool threads = p.groups.size() > 1;
+  ThreadedRegion counting(timers, threads);
+#pragma omp parallel for schedule(dynamic, 64) if (threads)
+  for (Eigen::Index c = 0; c < m; ++c)
+    count[static_cast<std::size_t>(c) + 1] = static_cast<Eigen::Index>(cols.count(c));
   counting.done();
   for (std::size_t c = 0; c < static_cast<std::size_t>(m); ++c) count[c + 1] += count[c];
   sys.W.resize(m, m);
@@ -125,23 +173,30 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix, StageTimers*
   double* const vals = sys.W.valuePtr();
   ThreadedRegion filling(timers, threads);
 #pragma omp parallel for schedule(dynamic, 64) if (threads)
+  for (Eigen::Index c = 0; c < m; ++c)
+    cols.fill(c, rows + count[static_cast<std::size_t>(c)],
+              vals + count[static_cast<std::size_t>(c)]);
+  return sys;
+}
+
+template <int Dim>
+NormalSystem refresh_normal_system(const Problem<Dim>& p, const std::vector<char>& stale,
+                                   Eigen::SparseMatrix<double>& W, StageTimers* timers) {
+  const auto m = static_cast<Eigen::Index>(p.contacts.size());
+  NormalSystem sys;
+  const NormalColumns<Dim> cols(p, true, sys);
+  const auto is_stale = [&](std::int32_t s) {
+    const std::int64_t g = s >= 0 ? cols.group_of(s) : -1;
+    return g >= 0 && stale[static_cast<std::size_t>(g)] != 0;
+  };
+  const bool threads = p.groups.size() > 1;
+  ThreadedRegion filling(timers, threads);
+#pragma omp parallel for schedule(dynamic, 64) if (threads)
   for (Eigen::Index c = 0; c < m; ++c) {
     const Contact<Dim>& k = p.contacts[static_cast<std::size_t>(c)];
-    const auto [l1, l2] = lists(k);
-    const std::size_t r1 = resource(k.b), r2 = k.a >= 0 ? resource(k.a) : 0;
-    const auto ci = static_cast<std::int32_t>(c);
-    const Entry f1 = entry(ci, k.b, 1.0), f2 = k.a >= 0 ? entry(ci, k.a, -1.0) : Entry{};
-    std::size_t i = 0, j = 0;
-    auto out = count[static_cast<std::size_t>(c)];
-    while (i < l1->size() || j < l2->size()) {
-      const std::int32_t c1 = i < l1->size() ? (*l1)[i].contact : std::numeric_limits<int>::max();
-      const std::int32_t c2 = j < l2->size() ? (*l2)[j].contact : std::numeric_limits<int>::max();
-      double v = 0;
-      if (c1 <= c2) v += value(r1, (*l1)[i++], f1);
-      if (c2 <= c1) v += value(r2, (*l2)[j++], f2);
-      rows[out] = std::min(c1, c2);
-      vals[out++] = v;
-    }
+    if (!is_stale(k.b) && !is_stale(k.a)) continue;
+    const int at = W.outerIndexPtr()[c];
+    cols.fill(c, W.innerIndexPtr() + at, W.valuePtr() + at);
   }
   return sys;
 }
@@ -603,13 +658,31 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
       }
     }
     ScopedStage assemble(settings.timers, "contact.as.assemble");
-    NormalSystem sys = normal_system(problem, !reuse, settings.timers);
+    // W made again only in the columns of the groups whose G changed, when nothing else did (the
+    // Newton iterations of a step in which some grains factorise anew): the same W, bit for bit.
+    std::vector<double> normals;
+    if (cache && !reuse) {
+      normals.reserve(problem.contacts.size() * Dim);
+      for (const Contact<Dim>& c : problem.contacts)
+        normals.insert(normals.end(), c.normal.data(), c.normal.data() + Dim);
+    }
+    const bool refresh = cache && !reuse && cache->pattern && cache->refreshable &&
+                         cache->stale.size() == problem.groups.size() &&
+                         cache->W.cols() == static_cast<Eigen::Index>(problem.contacts.size()) &&
+                         cache->normals == normals;
+    NormalSystem sys = refresh
+                           ? refresh_normal_system(problem, cache->stale, cache->W, settings.timers)
+                           : normal_system(problem, !reuse, settings.timers);
     ActiveSetCache local;
     ActiveSetCache& kept = cache ? *cache : local;
     if (!reuse) {
-      kept.W = std::move(sys.W);
+      if (!refresh) kept.W = std::move(sys.W);
       kept.factor.active.clear();
       kept.valid = true;
+      kept.pattern = true;
+      kept.refreshable = false;
+      kept.stale.assign(problem.groups.size(), 0);
+      kept.normals = std::move(normals);
     }
     const Eigen::SparseMatrix<double>& W = kept.W;
     assemble.done();
@@ -742,8 +815,10 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
   return result;
 }
 
-#define MPMCD_INSTANTIATE(D)                                                     \
-  template NormalSystem normal_system<D>(const Problem<D>&, bool, StageTimers*); \
+#define MPMCD_INSTANTIATE(D)                                                                  \
+  template NormalSystem normal_system<D>(const Problem<D>&, bool, StageTimers*);              \
+  template NormalSystem refresh_normal_system<D>(const Problem<D>&, const std::vector<char>&, \
+                                                 Eigen::SparseMatrix<double>&, StageTimers*); \
   template GsResult solve_active_set<D>(Problem<D>&, const GsSettings&, ActiveSetCache*);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)

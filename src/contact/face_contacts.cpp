@@ -195,68 +195,141 @@ double Detector<Dim>::grain_face_contacts(const DetectInput<Dim>& in,
     speed += in.gravity.norm() * in.dt;
     cut = std::min(range, cs.gap_horizon * 2.0 * speed * in.dt);
   }
+  // |x - y| <= r, tested first on the squares with a margin of 1e-12 (no sqrt for the points far
+  // beyond r, the most of those the searches meet), then exactly as |x - y| <= r.
+  const auto within = [](const Vec<Dim>& x, const Vec<Dim>& y, double r) {
+    const double d2 = (x - y).squaredNorm();
+    return d2 <= r * r * (1.0 + 1e-12) && std::sqrt(d2) <= r;
+  };
+  // The passes of each grain X, done together on one thread: whether a face of X is interior
+  // depends on X alone, so it is decided once per point for all of X's passes, first with the
+  // domain that held the probe last step (interior_hint_, checked as the search checks it: a
+  // different domain that holds it gives the same answer), then by the search.
+  std::vector<std::vector<std::size_t>> passes_of;  // per X in order of first pass: its passes
+  {
+    std::vector<std::int32_t> slot_of(fields.size(), -1);
+    for (std::size_t pi = 0; pi < passes.size(); ++pi) {
+      std::int32_t& sx = slot_of[static_cast<std::size_t>(passes[pi].X)];
+      if (sx < 0) {
+        sx = static_cast<std::int32_t>(passes_of.size());
+        passes_of.emplace_back();
+      }
+      passes_of[static_cast<std::size_t>(sx)].push_back(pi);
+    }
+  }
+  if (interior_hint_.size() != points.x.size()) {
+    std::array<std::int64_t, 2 * Dim> none;
+    none.fill(-1);
+    interior_hint_.assign(points.x.size(), none);
+  }
   std::vector<std::vector<Hit>> hits(passes.size());
   double items = 0;
-  const auto npasses = static_cast<std::int64_t>(passes.size());
+  const auto ngroups = static_cast<std::int64_t>(passes_of.size());
   {
-    const ThreadedRegion threaded(in.timers, npasses > 1);
-#pragma omp parallel for schedule(dynamic, 1) if (npasses > 1) reduction(+ : items)
-    for (std::int64_t pi = 0; pi < npasses; ++pi) {
-      const Pass& ps = passes[static_cast<std::size_t>(pi)];
-      const std::int32_t X = ps.X, Y = ps.Y;
+    const ThreadedRegion threaded(in.timers, ngroups > 1);
+#pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1) reduction(+ : items)
+    for (std::int64_t gi = 0; gi < ngroups; ++gi) {
+      const std::vector<std::size_t>& mine = passes_of[static_cast<std::size_t>(gi)];
+      const std::int32_t X = passes[mine.front()].X;
       const FieldView<Dim>& wx = fields[X];
-      // Cells searched around a face centre for Y's domains: those within max reach + cut of it
-      // (at most the 2 cells searched before; usually 1 of them, a third of the points).
-      const int gap_radius = static_cast<int>(
-          std::min(2.0, std::ceil((by_cell[static_cast<std::size_t>(Y)].max_reach + cut) / h)));
-      std::vector<std::int64_t> zone;
-      for (std::size_t i = ps.i0; i < ps.i1; ++i)
-        for (std::int32_t k = wx.node_pts_start[links[i][ps.col]];
-             k < wx.node_pts_start[links[i][ps.col] + 1]; ++k)
-          zone.push_back(wx.begin + wx.node_pts[k]);
-      std::sort(zone.begin(), zone.end());
-      zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
-      std::vector<Vec<Dim>> xs;
-      xs.reserve(corners);
-      Hit hit;
-      for (const std::int64_t p : zone) {
+      // X's points at each pass's shared nodes (ascending), and their union.
+      std::vector<std::vector<std::int64_t>> zones(mine.size());
+      std::vector<std::int64_t> all;
+      for (std::size_t j = 0; j < mine.size(); ++j) {
+        const Pass& ps = passes[mine[j]];
+        std::vector<std::int64_t>& zone = zones[j];
+        for (std::size_t i = ps.i0; i < ps.i1; ++i)
+          for (std::int32_t k = wx.node_pts_start[links[i][ps.col]];
+               k < wx.node_pts_start[links[i][ps.col] + 1]; ++k)
+            zone.push_back(wx.begin + wx.node_pts[k]);
+        std::sort(zone.begin(), zone.end());
+        zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+        all.insert(all.end(), zone.begin(), zone.end());
+      }
+      std::sort(all.begin(), all.end());
+      all.erase(std::unique(all.begin(), all.end()), all.end());
+      // Interior faces of those points, bit 2 k + side: another domain of X holds the point half
+      // a domain beyond the face (searched among X's centres within a cell of it).
+      std::vector<std::uint8_t> interior(all.size(), 0);
+      for (std::size_t u = 0; u < all.size(); ++u) {
+        const std::int64_t p = all[u];
         const Mat<Dim> D = points.F[p] * points.domain[p];
         const Mat<Dim>& Dinv = point_dinv_[p];
+        const auto holds = [&](std::int64_t q, const Vec<Dim>& xt) {
+          return q != p && within(points.x[q], xt, point_reach_[q]) &&
+                 (point_dinv_[q] * (xt - points.x[q])).cwiseAbs().maxCoeff() <= 1.0;
+        };
         for (int k = 0; k < Dim; ++k)
           for (const int side : {0, 1}) {
-            // Face s_k = sign: outward normal sign D^-T e_k, at 1/|D^-T e_k| from the centre.
             const double sign = side ? 1.0 : -1.0;
             const Vec<Dim> m = Dinv.row(k).transpose();
             const double len = m.norm();
             const Vec<Dim> nu = sign * m / len;
             const Vec<Dim> xf = points.x[p] + sign * D.col(k);
-            items += 1;
-            // Interior face: another domain of X holds the point half a domain beyond it.
             const Vec<Dim> xt = xf + 0.5 / len * nu;
-            bool interior = false;
-            near(X, xt, 1, [&](std::int64_t q) {
-              if (interior || q == p || (points.x[q] - xt).norm() > point_reach_[q]) return;
-              interior = (point_dinv_[q] * (xt - points.x[q])).cwiseAbs().maxCoeff() <= 1.0;
-            });
-            if (interior) continue;
-            // Only domains within `cut` of the face centre can give a gap <= cut (their reach
-            // bounds them), and once the face is inside one (gap <= 0) the gap is 0.
-            double gap = std::numeric_limits<double>::infinity();
-            near(Y, xf, gap_radius, [&](std::int64_t q) {
-              if (gap > 0.0 && (points.x[q] - xf).norm() <= point_reach_[q] + cut)
-                gap = std::min(gap, ray_entry<Dim>(points.x[q], point_dinv_[q], xf, nu));
-            });
-            if (!(gap <= cut)) continue;
-            xs.clear();
-            face_corners<Dim>(points.x[p], D, k, sign, xs);
-            if (!corner_weights<Dim>(fields[X].box, xs, 1.0, hit.nodes_x, hit.weights_x) ||
-                !corner_weights<Dim>(fields[Y].box, xs, 1.0, hit.nodes_y, hit.weights_y))
-              continue;
-            hit.key = -1 - (p * 2 * Dim + 2 * k + side);
-            hit.normal = nu;
-            hit.gap = std::max(0.0, gap);
-            hits[static_cast<std::size_t>(pi)].push_back(hit);
+            std::int64_t& hint = interior_hint_[p][static_cast<std::size_t>(2 * k + side)];
+            bool in = false;
+            if (hint >= wx.begin && hint < wx.end) {
+              // The search only sees centres within one cell of xt's cell (per axis).
+              const IVec<Dim> dc = cell_of(points.x[hint]) - cell_of(xt);
+              in = dc.cwiseAbs().maxCoeff() <= 1 && holds(hint, xt);
+            }
+            if (!in) {
+              hint = -1;
+              near(X, xt, 1, [&](std::int64_t q) {
+                if (!in && holds(q, xt)) {
+                  in = true;
+                  hint = q;
+                }
+              });
+            }
+            if (in) interior[u] |= static_cast<std::uint8_t>(1u << (2 * k + side));
           }
+      }
+      std::vector<Vec<Dim>> xs;
+      xs.reserve(corners);
+      Hit hit;
+      for (std::size_t j = 0; j < mine.size(); ++j) {
+        const std::size_t pi = mine[j];
+        const std::int32_t Y = passes[pi].Y;
+        // Cells searched around a face centre for Y's domains: those within max reach + cut of
+        // it (at most the 2 cells searched before; usually 1 of them, a third of the points).
+        const double y_reach = by_cell[static_cast<std::size_t>(Y)].max_reach;
+        const int gap_radius = static_cast<int>(std::min(2.0, std::ceil((y_reach + cut) / h)));
+        std::size_t u = 0;
+        for (const std::int64_t p : zones[j]) {
+          while (all[u] != p) ++u;  // both ascending, zones[j] within all
+          const Mat<Dim> D = points.F[p] * points.domain[p];
+          const Mat<Dim>& Dinv = point_dinv_[p];
+          for (int k = 0; k < Dim; ++k)
+            for (const int side : {0, 1}) {
+              items += 1;
+              if (interior[u] & (1u << (2 * k + side))) continue;
+              // Face s_k = sign: outward normal sign D^-T e_k, at 1/|D^-T e_k| from the centre.
+              const double sign = side ? 1.0 : -1.0;
+              const Vec<Dim> m = Dinv.row(k).transpose();
+              const double len = m.norm();
+              const Vec<Dim> nu = sign * m / len;
+              const Vec<Dim> xf = points.x[p] + sign * D.col(k);
+              // Only domains within `cut` of the face centre can give a gap <= cut (their reach
+              // bounds them), and once the face is inside one (gap <= 0) the gap is 0.
+              double gap = std::numeric_limits<double>::infinity();
+              near(Y, xf, gap_radius, [&](std::int64_t q) {
+                if (gap > 0.0 && within(points.x[q], xf, point_reach_[q] + cut))
+                  gap = std::min(gap, ray_entry<Dim>(points.x[q], point_dinv_[q], xf, nu));
+              });
+              if (!(gap <= cut)) continue;
+              xs.clear();
+              face_corners<Dim>(points.x[p], D, k, sign, xs);
+              if (!corner_weights<Dim>(fields[X].box, xs, 1.0, hit.nodes_x, hit.weights_x) ||
+                  !corner_weights<Dim>(fields[Y].box, xs, 1.0, hit.nodes_y, hit.weights_y))
+                continue;
+              hit.key = -1 - (p * 2 * Dim + 2 * k + side);
+              hit.normal = nu;
+              hit.gap = std::max(0.0, gap);
+              hits[pi].push_back(hit);
+            }
+        }
       }
     }
   }

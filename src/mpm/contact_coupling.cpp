@@ -328,14 +328,17 @@ double ImplicitSolver<Dim>::update_contacts(StepStats& stats) {
   const auto ngroups = static_cast<std::int64_t>(problem_.groups.size());
   if (!slot_bases_valid_) build_slot_bases();
   bool new_compliance = false;
+  std::vector<char> changed(static_cast<std::size_t>(ngroups), 0);  // per group: a new G
   ThreadedRegion threaded(&timers_, ngroups > 1);
 #pragma omp parallel for schedule(dynamic, 1) if (ngroups > 1) reduction(|| : new_compliance)
-  for (std::int64_t gi = 0; gi < ngroups; ++gi)
-    new_compliance =
-        grain_compliance(static_cast<std::size_t>(slot_ref_[problem_.groups[gi].slots[0]].first)) ||
-        new_compliance;
+  for (std::int64_t gi = 0; gi < ngroups; ++gi) {
+    const bool fresh =
+        grain_compliance(static_cast<std::size_t>(slot_ref_[problem_.groups[gi].slots[0]].first));
+    changed[static_cast<std::size_t>(gi)] = fresh ? 1 : 0;
+    new_compliance = fresh || new_compliance;
+  }
   threaded.done();
-  if (new_compliance) as_cache_.valid = false;
+  if (new_compliance) as_cache_.compliance_changed(changed);
   for (const auto& w : work_)
     if (!w->failure.empty()) return 1.0;
   // Free velocities: the grains' current iterates without their contact impulses (method.md §4).

@@ -87,6 +87,7 @@ void ImplicitSolver<Dim>::detect_contacts(double dt) {
   slot_bases_valid_ = false;
   sweep_order_ready_ = false;
   as_cache_.valid = false;
+  as_cache_.pattern = false;
   slot_ref_.clear();
   slot_next_.clear();
   slot_start_.assign(1, 0);

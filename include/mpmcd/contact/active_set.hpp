@@ -32,6 +32,14 @@ template <int Dim>
 NormalSystem normal_system(const Problem<Dim>& problem, bool with_matrix = true,
                            StageTimers* timers = nullptr);
 
+/// Column by column as normal_system makes them, W's columns of the contacts that touch a group
+/// marked in `stale` (per group: its G changed), written in place into `W`, which must be the
+/// problem's W but for those groups (the same contacts, slots and normals); the other columns
+/// depend on other groups only and are kept. Returns b and p (its W left empty).
+template <int Dim>
+NormalSystem refresh_normal_system(const Problem<Dim>& problem, const std::vector<char>& stale,
+                                   Eigen::SparseMatrix<double>& W, StageTimers* timers = nullptr);
+
 /// A sparse LDL^T of W_BB + delta I for one base set B of contacts, and what the pivoting's
 /// solves on other active sets A near B reuse: A differs from B by the contacts N that entered
 /// and R that left, and a solve on A borders the base factorisation with them (a Schur
@@ -58,6 +66,23 @@ struct ActiveSetCache {
   bool valid = false;             ///< W and factor describe the problem's current W [-]
   Eigen::SparseMatrix<double> W;  ///< the normal Delassus matrix [s/kg]
   ShiftedFactor factor;           ///< the last factorisation of the pivoting
+  /// W was made for the problem's contacts and slots (the caller clears it when they change) [-].
+  bool pattern = false;
+  /// Since W was made, only the groups marked in `stale` changed their G (compliance_changed):
+  /// the next solve makes only their columns again (refresh_normal_system) if the contacts'
+  /// normals are still `normals`. Clearing `valid` alone makes W anew [-].
+  bool refreshable = false;
+  std::vector<char> stale;      ///< per group: its G changed since W was made [-]
+  std::vector<double> normals;  ///< the contacts' normals W was made with (Dim per contact) [-]
+  /// Marks the groups with changed[g] != 0 as changed: not `valid`, and `refreshable` while W's
+  /// pattern holds and the group count is W's.
+  void compliance_changed(const std::vector<char>& changed) {
+    const bool was_current = valid || refreshable;
+    valid = false;
+    refreshable = pattern && was_current && stale.size() == changed.size();
+    if (!refreshable) return;
+    for (std::size_t g = 0; g < changed.size(); ++g) stale[g] = stale[g] || changed[g];
+  }
 };
 
 /// Solves a problem whose contacts are all frictionless: one Gauss-Seidel sweep from the

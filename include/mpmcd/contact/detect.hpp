@@ -120,6 +120,10 @@ class Detector {
   std::vector<double> point_reach_;
   // Per point, with face contacts between grains: (F D0)^-1, the inverse of its domain's map [1/m].
   std::vector<Mat<Dim>> point_dinv_;
+  // Per point and face (2 k + side), with face contacts between grains: the point of the same
+  // grain whose domain held the probe beyond that face at the last detection, or -1 (a hint
+  // that only shortens the interior test; grain_face_contacts) [-].
+  std::vector<std::array<std::int64_t, 2 * Dim>> interior_hint_;
 };
 
 /// A slot for the faces of points `pts` facing a wall of unit normal n (into the domain): the mean

@@ -233,6 +233,52 @@ TEST(ActiveSet, CachedMatrixAndFactorisationGiveTheSameImpulses) {
     EXPECT_EQ(stiffer.contacts[c].impulse, stiffer_scratch.contacts[c].impulse) << "contact " << c;
 }
 
+TEST(ActiveSet, ColumnsOfChangedGroupsMadeAgainGiveTheMatrixMadeAnew) {
+  // A Newton iteration in which one grain factorises anew changes that group's G only: the
+  // cache then makes again only the columns of the contacts on that group
+  // (refresh_normal_system), which must give W bit for bit as made anew, and the solve the same
+  // impulses as one without the cache. Changed normals make W anew.
+  const auto base = two_grain_problem(20, 3, 17);
+  const contact::GsSettings s = tight();
+  contact::ActiveSetCache cache;
+  auto first = base;
+  ASSERT_TRUE(contact::solve_active_set(first, s, &cache).converged);
+  ASSERT_TRUE(cache.valid && cache.pattern);
+  auto next = first;
+  next.groups[1].Gr *= 0.7;
+  next.groups[1].Gr(0, 0) += 0.01;  // not a multiple of the old one
+  cache.compliance_changed({0, 1});
+  EXPECT_FALSE(cache.valid);
+  EXPECT_TRUE(cache.refreshable);
+  auto scratch = next;
+  ASSERT_TRUE(contact::solve_active_set(next, s, &cache).converged);
+  ASSERT_TRUE(contact::solve_active_set(scratch, s).converged);
+  const Eigen::SparseMatrix<double> fresh = contact::normal_system(next).W;
+  ASSERT_EQ(cache.W.nonZeros(), fresh.nonZeros());
+  for (Eigen::Index k = 0; k < fresh.nonZeros(); ++k) {
+    EXPECT_EQ(cache.W.innerIndexPtr()[k], fresh.innerIndexPtr()[k]);
+    EXPECT_EQ(cache.W.valuePtr()[k], fresh.valuePtr()[k]) << "entry " << k;
+  }
+  // Grain 1's columns did change: W is not the first one.
+  EXPECT_GT((cache.W - contact::normal_system(first).W).norm(), 0.0);
+  for (std::size_t c = 0; c < next.contacts.size(); ++c)
+    EXPECT_EQ(next.contacts[c].impulse, scratch.contacts[c].impulse) << "contact " << c;
+  // A turned normal and a changed group: W made anew, with the new normal.
+  auto turned = next;
+  turned.contacts[0].normal = Vec<2>(0.1, 1.0).normalized();
+  turned.groups[0].Gr *= 0.9;
+  cache.compliance_changed({1, 0});
+  ASSERT_TRUE(contact::solve_active_set(turned, s, &cache).converged);
+  EXPECT_EQ((cache.W - contact::normal_system(turned).W).norm(), 0.0);
+  // Clearing `valid` alone (not through compliance_changed) also makes W anew.
+  auto softer = turned;
+  for (auto& g : softer.groups) g.Gr *= 2.0;
+  cache.valid = false;
+  EXPECT_FALSE(cache.refreshable);
+  ASSERT_TRUE(contact::solve_active_set(softer, s, &cache).converged);
+  EXPECT_EQ((cache.W - contact::normal_system(softer).W).norm(), 0.0);
+}
+
 TEST(ActiveSet, BorderedSolveMatchesAFreshFactorisation) {
   // Contacts entering and leaving the factorised set: the solve borders the kept factorisation
   // (a Schur complement of the changed contacts) instead of factorising anew, and must reach the
