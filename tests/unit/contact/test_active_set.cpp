@@ -233,16 +233,24 @@ TEST(ActiveSet, CachedMatrixAndFactorisationGiveTheSameImpulses) {
     EXPECT_EQ(stiffer.contacts[c].impulse, stiffer_scratch.contacts[c].impulse) << "contact " << c;
 }
 
+namespace {
+// `base` solved once with `cache` (left valid by the solve), its impulses the answer.
+contact::Problem<2> solved_with_cache(const contact::Problem<2>& base, const contact::GsSettings& s,
+                                      contact::ActiveSetCache& cache) {
+  auto solved = base;
+  EXPECT_TRUE(contact::solve_active_set(solved, s, &cache).converged);
+  return solved;
+}
+}  // namespace
+
 TEST(ActiveSet, ColumnsOfChangedGroupsMadeAgainGiveTheMatrixMadeAnew) {
   // A Newton iteration in which one grain factorises anew changes that group's G only: the
   // cache then makes again only the columns of the contacts on that group
   // (refresh_normal_system), which must give W bit for bit as made anew, and the solve the same
   // impulses as one without the cache. Changed normals make W anew.
-  const auto base = two_grain_problem(20, 3, 17);
   const contact::GsSettings s = tight();
   contact::ActiveSetCache cache;
-  auto first = base;
-  ASSERT_TRUE(contact::solve_active_set(first, s, &cache).converged);
+  const auto first = solved_with_cache(two_grain_problem(20, 3, 17), s, cache);
   ASSERT_TRUE(cache.valid && cache.pattern);
   auto next = first;
   next.groups[1].Gr *= 0.7;
@@ -286,8 +294,7 @@ TEST(ActiveSet, BorderedSolveMatchesAFreshFactorisation) {
   const auto base = two_grain_problem(60, 4, 17);
   const contact::GsSettings s = tight();
   contact::ActiveSetCache cache;
-  auto first = base;
-  ASSERT_TRUE(contact::solve_active_set(first, s, &cache).converged);
+  auto first = solved_with_cache(base, s, cache);
   // Open two contacts and close two: the first two wall contacts' slots lifted off the wall, the
   // gaps of two open grain-grain contacts closed.
   auto next = first;
