@@ -344,20 +344,36 @@ void p2g(GrainField<Dim>& w, const grid::Grid<Dim>& grid, const Settings<Dim>& s
       if (inside) w.stencil_nb[a * w.S + s] = w.box_to_active[c.dot(stride)];
     }
   w.K_blk.resize(na * w.S);
-  // Sparse pattern of the Newton matrix and the map from stencil blocks to stored values.
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(na * w.S * Dim * Dim);
-  for (std::size_t a = 0; a < na; ++a)
-    for (int s = 0; s < w.S; ++s) {
-      const std::int32_t b = w.stencil_nb[a * w.S + s];
-      if (b < 0) continue;
-      for (int i = 0; i < Dim; ++i)
-        for (int j = 0; j < Dim; ++j) trip.emplace_back(a * Dim + i, b * Dim + j, 0.0);
-    }
+  // Sparse pattern of the Newton matrix and the map from stencil blocks to stored values, in
+  // compressed storage directly: the stencil is symmetric (b couples to a when a couples to b),
+  // so column (b, j) holds the rows (a, i) of b's neighbours a, ascending.
   const auto ndof = static_cast<Eigen::Index>(na * Dim);
+  std::vector<std::int32_t> nbrs;  // per node, its neighbours ascending, from nbr_start
+  std::vector<std::int64_t> nbr_start(na + 1, 0);
+  nbrs.reserve(na * w.S);
+  for (std::size_t b = 0; b < na; ++b) {
+    const auto first = static_cast<std::ptrdiff_t>(nbrs.size());
+    for (int s = 0; s < w.S; ++s)
+      if (w.stencil_nb[b * w.S + s] >= 0) nbrs.push_back(w.stencil_nb[b * w.S + s]);
+    std::sort(nbrs.begin() + first, nbrs.end());
+    nbr_start[b + 1] = static_cast<std::int64_t>(nbrs.size());
+  }
   w.A.resize(ndof, ndof);
-  w.A.setFromTriplets(trip.begin(), trip.end());
-  w.A.makeCompressed();
+  w.A.resizeNonZeros(static_cast<Eigen::Index>(nbrs.size()) * Dim * Dim);
+  int* const outer_w = w.A.outerIndexPtr();
+  int* const inner_w = w.A.innerIndexPtr();
+  outer_w[0] = 0;
+  for (std::size_t b = 0; b < na; ++b) {
+    const std::int64_t n = nbr_start[b + 1] - nbr_start[b];
+    for (int j = 0; j < Dim; ++j) {
+      const std::size_t col = b * Dim + static_cast<std::size_t>(j);
+      int at = outer_w[col];
+      for (std::int64_t k = nbr_start[b]; k < nbr_start[b + 1]; ++k)
+        for (int i = 0; i < Dim; ++i) inner_w[at++] = nbrs[static_cast<std::size_t>(k)] * Dim + i;
+      outer_w[col + 1] = outer_w[col] + static_cast<int>(n * Dim);
+    }
+  }
+  std::fill(w.A.valuePtr(), w.A.valuePtr() + w.A.nonZeros(), 0.0);
   w.value_index.assign(na * w.S * Dim * Dim, -1);
   const int* outer = w.A.outerIndexPtr();
   const int* inner = w.A.innerIndexPtr();
