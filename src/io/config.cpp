@@ -319,7 +319,8 @@ Schema build_schema() {
        KeySpec::boolean("modified_newton", &SolverSection::modified_newton,
                         "modified Newton: factorise the Newton matrix once per step and reuse it "
                         "(and the contact compliance) in later iterations, refactorising when the "
-                        "residual stalls; same converged answer, fewer factorisations")
+                        "residual stalls above residual_tolerance; same converged answer, fewer "
+                        "factorisations")
            .default_of_member(),
        KeySpec::number("dense_fill", &SolverSection::dense_fill, "",
                        "with ldlt, a grain whose sparse factor fills at least this fraction of "

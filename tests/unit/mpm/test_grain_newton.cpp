@@ -160,3 +160,27 @@ TEST(GrainNewton, ConvergesQuadratically3D) {
   check_newton<3, grid::UGimp1D>();
   check_newton<3, grid::Cpdi1D>();
 }
+
+TEST(ModifiedNewton, RefactorisesOnAStallAboveTheToleranceOnly) {
+  // reuse_factor (the modified Newton's rule, docs/contact.md "A converged residual is not a
+  // stall"): keep the step's factorisation while the residual (|R| / reference per iteration)
+  // halves, or once it is within residual_tolerance; rebuild the tangent on a stall above it.
+  mpm::GrainField<2> w;
+  mpm::Settings<2> s;
+  s.residual_tolerance = 1e-8;
+  w.history = {1e-2, 1e-4};
+  EXPECT_FALSE(mpm::reuse_factor(w, s));  // no factorisation in this step yet
+  w.factor_in_step = true;
+  EXPECT_TRUE(mpm::reuse_factor(w, s));  // falling fast
+  w.history = {1e-4, 0.6e-4};
+  EXPECT_FALSE(mpm::reuse_factor(w, s));  // a stall above the tolerance
+  w.history = {3e-10, 3e-10};
+  EXPECT_TRUE(mpm::reuse_factor(w, s));  // converged: at its floor, not stalled
+  w.history = {1e-12, 1e-9};
+  EXPECT_TRUE(mpm::reuse_factor(w, s));  // risen, but still within the tolerance
+  w.history = {1e-12, 2e-8};
+  EXPECT_FALSE(mpm::reuse_factor(w, s));  // risen above it
+  s.modified_newton = false;
+  w.history = {3e-10, 3e-10};
+  EXPECT_FALSE(mpm::reuse_factor(w, s));  // full Newton: a new tangent every iteration
+}
