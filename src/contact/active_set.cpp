@@ -638,6 +638,23 @@ bool primal_active_set(ShiftedSolver& solver, const Eigen::SparseMatrix<double>&
   return false;
 }
 
+// The W_cc that the proximal shift is scaled by [s/kg]: the largest, but at most 1,000 times the
+// median. A shift delta slows the proximal steps of a contact with W_cc ~ d by delta / d per
+// step, and the pivoting stops once the violation no longer halves from one to the next. In
+// dense 3D packings a few face contacts on nearly empty nodes' slots had W_cc up to 1e7 times the
+// median: a shift of 1e-12 of theirs left the other contacts' violation at 1e-8 of the
+// impulses, above the tolerance, and Gauss-Seidel then swept 1,000 times without converging
+// (docs/contact.md, "The proximal shift and nearly massless slots"). In the 2D paper case at
+// d/4, 51 of the first 1,712 solves had a largest W_cc above 1,000 times the median (up to
+// 6,600 times).
+double proximal_reference(const Eigen::VectorXd& d) {
+  const double largest = d.maxCoeff();
+  std::vector<double> sorted(d.data(), d.data() + d.size());
+  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+  std::nth_element(sorted.begin(), mid, sorted.end());
+  return std::min(largest, 1000.0 * *mid);
+}
+
 // Gauss-Seidel's error of frictionless contacts with impulses p: the relative distance
 // |loc - p| / |p| to their local solutions loc_c = max(0, p_c - w_c / W_cc), w = b + W p (the
 // local problem of contact c with the others' impulses fixed, method.md §4).
@@ -715,12 +732,14 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
     // Proximal point (Rockafellar 1976): p_{k+1} solves the complementarity problem of
     // min 1/2 p.W p + b.p + delta/2 |p - p_k|^2, i.e. the matrix W + delta I and the vector
     // b - delta p_k, whose condition number is at most max W_cc / delta however redundant the
-    // contacts; its solutions converge to one of the original problem. From a warm start near
-    // the answer (the Newton iterations and steps of a quasi-static run) one step suffices.
-    // delta starts at 1e-12 of the largest W_cc, so that the proximal steps converge fast, and
-    // grows 100-fold (to 1e-6) whenever the pivoting cycles on an ill-conditioned W_AA.
-    const double w_max = d.maxCoeff();
-    double delta = 1e-12 * w_max;
+    // contacts (a nearly massless slot's row, whose W_cc may be far above delta's reference, is
+    // dominated by its diagonal); its solutions converge to one of the original problem. From a
+    // warm start near the answer (the Newton iterations and steps of a quasi-static run) one step
+    // suffices. delta starts at 1e-12 of the reference W_cc (proximal_reference), so that the
+    // proximal steps converge fast, and grows 100-fold (to 1e-6 of it) whenever the pivoting cycles
+    // on an ill-conditioned W_AA.
+    const double w_ref = proximal_reference(d);
+    double delta = 1e-12 * w_ref;
     ShiftedSolver solver(W, kept.factor, delta, settings.timers);
     Eigen::VectorXd p = sys.p.cwiseMax(0.0), q, w, next(m);
     Eigen::VectorXd w_p;  // b + W p at the last accepted impulses p [m/s]
@@ -799,7 +818,7 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
                                     result.pivots);
       }
       if (!pivoted) {
-        if (delta >= 1e-6 * w_max) break;
+        if (delta >= 1e-6 * w_ref) break;
         delta *= 100;
         solver.set_shift(delta);
         last = std::numeric_limits<double>::infinity();
