@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -214,6 +216,20 @@ constexpr int kMaxBordered = 96;
 constexpr int kFactorWays = 2;
 // Iterative refinement steps of a bordered solve.
 constexpr int kMaxRefinements = 4;
+// W_AA goes to the supernodal factorisation (SupernodalLlt) when L's columns have at least this
+// many entries on average (its multiply-adds over its entries) and the factorisation at least
+// kSupernodalFlops multiply-adds, and to TreeLdlt otherwise. Measured (docs/contact.md, "The
+// supernodal factorisation"): the 300-sphere 3D state (mean column about 1,350, 3e10
+// multiply-adds) factorises about 10 times faster supernodal; the 2D paper state at d/8 (mean
+// column about 130, 6e7) 1.5 times slower on 2 threads, where TreeLdlt splits its tree.
+constexpr double kSupernodalColumns = 400;
+constexpr double kSupernodalFlops = 1e8;
+
+// Whether a factor with `flops` multiply-adds and `nonzeros` entries is made supernodal.
+bool use_supernodal(double flops, double nonzeros) {
+  if (const char* force = std::getenv("MPMCD_SUPERNODAL")) return force[0] == '1';
+  return flops >= kSupernodalFlops && flops >= kSupernodalColumns * nonzeros;
+}
 // Projected Gauss-Seidel sweeps on W before the first active set of a new W (sweep_on_w).
 constexpr int kWSweeps = 20;
 // Contacts from which the passes over W's columns run on the threads [-].
@@ -375,6 +391,7 @@ class ShiftedSolver {
  private:
   // Makes `active` the base set: W_BB + delta I factorised, no bordered columns.
   bool factorise(const std::vector<std::int32_t>& active) {
+    ScopedStage stage(timers_, "contact.as.factor");
     const auto na = static_cast<Eigen::Index>(active.size());
     const auto m = static_cast<std::size_t>(W_.rows());
     f_.active.clear();
@@ -412,15 +429,27 @@ class ShiftedSolver {
       }
     }
     gathering.done();
+    // The ordering and L's column counts first; long columns (dense 3D packings) go to the
+    // supernodal factorisation with the same ordering, the others to TreeLdlt's loop.
     f_.ldlt.setShift(f_.delta);
-    f_.ldlt.compute_on_threads(f_.Waa, kFactorWays);
-    if (f_.ldlt.info() != Eigen::Success) return false;
-    const auto& L = f_.ldlt.matrixL().nestedExpression();
-    f_.factor_flops = 0;
-    for (Eigen::Index j = 0; j < L.outerSize(); ++j) {
-      const auto c = static_cast<double>(L.outerIndexPtr()[j + 1] - L.outerIndexPtr()[j]);
-      f_.factor_flops += c * c;
+    f_.ldlt.analyze(f_.Waa);
+    f_.factor_flops = f_.ldlt.symbolic_flops();
+    f_.factor_nonzeros = static_cast<double>(f_.ldlt.matrixL().nestedExpression().nonZeros());
+    f_.supernodal = use_supernodal(f_.factor_flops, f_.factor_nonzeros);
+    if (f_.supernodal) {
+      if (!f_.llt.compute(f_.Waa, f_.delta, f_.ldlt.order().data())) return false;
+    } else {
+      f_.ldlt.factorize_analyzed(kFactorWays);
+      if (f_.ldlt.info() != Eigen::Success) return false;
     }
+    // MPMCD_TRACE_FACTOR=1: one line per factorisation on stderr (docs/contact.md, "The
+    // supernodal factorisation"), to tune kSupernodalColumns and kSupernodalFlops.
+    if (std::getenv("MPMCD_TRACE_FACTOR") != nullptr)
+      std::fprintf(
+          stderr,
+          "factor contacts=%ld active=%ld nnz_Waa=%ld nnz_L=%.0f flops=%.3g supernodal=%d\n",
+          static_cast<long>(W_.rows()), static_cast<long>(na), static_cast<long>(f_.Waa.nonZeros()),
+          f_.factor_nonzeros, f_.factor_flops, f_.supernodal ? 1 : 0);
     f_.active = active;
     f_.solved.resize(na, 2 * kMaxBordered);
     return true;
@@ -449,14 +478,14 @@ class ShiftedSolver {
     for (const std::int32_t b : bordered_) fresh += f_.column[static_cast<std::size_t>(b)] < 0;
     const auto k = static_cast<double>(bordered_.size());
     const double per_column = static_cast<double>(W_.nonZeros()) / static_cast<double>(W_.cols());
-    const double nnz_l = static_cast<double>(f_.ldlt.matrixL().nestedExpression().nonZeros());
-    return 4.0 * nnz_l * fresh + k * k * per_column < f_.factor_flops;
+    return 4.0 * f_.factor_nonzeros * fresh + k * k * per_column < f_.factor_flops;
   }
 
   // The bordered columns (W_BB + delta I)^-1 c (made once per contact and base) and the LU of
   // the Schur complement S = D - C^T (W_BB + delta I)^-1 C, with C = [W_BN, E_R] and D the
   // block diag(W_NN + delta I, 0); false if S is singular.
   bool prepare() {
+    ScopedStage stage(timers_, "contact.as.border");
     const auto k = static_cast<Eigen::Index>(bordered_.size());
     if (k == 0) return true;
     const auto nb = static_cast<Eigen::Index>(f_.active.size());
@@ -481,15 +510,20 @@ class ShiftedSolver {
       f_.owners.push_back(b);
     }
     const auto fresh = static_cast<std::ptrdiff_t>(f_.owners.size() - first);
-    ThreadedRegion columns(timers_, fresh > 1);
+    if (f_.supernodal) {  // one multi-column solve
+      if (fresh > 0)
+        f_.llt.solve_in_place(f_.solved.middleCols(static_cast<Eigen::Index>(first), fresh));
+    } else {
+      ThreadedRegion columns(timers_, fresh > 1);
 #pragma omp parallel for schedule(dynamic) if (fresh > 1)
-    for (std::ptrdiff_t i = 0; i < fresh; ++i) {
-      auto col = f_.solved.col(static_cast<Eigen::Index>(first) + i);
-      Eigen::VectorXd c = col;
-      f_.ldlt.solve_in_place(c);
-      col = c;
+      for (std::ptrdiff_t i = 0; i < fresh; ++i) {
+        auto col = f_.solved.col(static_cast<Eigen::Index>(first) + i);
+        Eigen::VectorXd c = col;
+        f_.ldlt.solve_in_place(c);
+        col = c;
+      }
+      columns.done();
     }
-    columns.done();
     Eigen::MatrixXd S(k, k);
     for (Eigen::Index j = 0; j < k; ++j) {
       const auto z = f_.solved.col(f_.column[static_cast<std::size_t>(bordered_[j])]);
@@ -519,11 +553,15 @@ class ShiftedSolver {
   // base solve u = (W_BB + delta I)^-1 r_B, the border y = S^-1 ([r_N; 0] - C^T u), then
   // x_B = u - (W_BB + delta I)^-1 C y and x_N = y (x_R = 0: y's R part is their multiplier).
   Eigen::VectorXd apply(const Eigen::VectorXd& r) const {
+    ScopedStage stage(timers_, "contact.as.apply");
     const auto nb = static_cast<Eigen::Index>(f_.active.size());
     Eigen::VectorXd u(nb);
     for (Eigen::Index i = 0; i < nb; ++i)
       u[i] = in_active_[static_cast<std::size_t>(f_.active[i])] ? r[f_.active[i]] : 0.0;
-    f_.ldlt.solve_in_place(u);
+    if (f_.supernodal)
+      f_.llt.solve_in_place(u);
+    else
+      f_.ldlt.solve_in_place(u);
     Eigen::VectorXd x = Eigen::VectorXd::Zero(r.size());
     const auto k = static_cast<Eigen::Index>(bordered_.size());
     if (k > 0) {

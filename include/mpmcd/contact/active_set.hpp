@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mpmcd/contact/problem.hpp"
+#include "mpmcd/core/supernodal_llt.hpp"
 #include "mpmcd/core/tree_ldlt.hpp"
 
 namespace mpmcd::contact {
@@ -49,7 +50,10 @@ struct ShiftedFactor {
   std::vector<std::int32_t> active;  ///< the contacts of B, ascending (empty: nothing factorised)
   Eigen::SparseMatrix<double> Waa;   ///< W restricted to B [s/kg]
   TreeLdlt ldlt;                     ///< LDL^T of Waa + delta I (numeric part on the threads)
+  SupernodalLlt llt;                 ///< or its supernodal L L^T (long columns of L)
+  bool supernodal = false;           ///< the base is factorised by `llt`, not `ldlt` [-]
   double factor_flops = 0;           ///< sum over L's columns of their count squared [-]
+  double factor_nonzeros = 0;        ///< entries of L [-]
   std::vector<std::int32_t> local;   ///< per contact: its index in B, or -1 [-]
   std::vector<std::int32_t> column;  ///< per contact: its column of `solved`, or -1 [-]
   std::vector<std::int32_t> owners;  ///< per column of `solved`: its contact [-]

@@ -35,6 +35,17 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
   /// thread count, so the factor is the same bits on any number of threads.
   void compute_on_threads(const Eigen::SparseMatrix<double>& A, int ways = 2, int min_size = 1000);
 
+  /// compute_on_threads() in two parts: analyze() orders A and counts L's entries per column
+  /// (symbolic_flops(), order()), factorize_analyzed() then factorises A + shift I.
+  void analyze(const Eigen::SparseMatrix<double>& A);
+  /// The numeric part of compute_on_threads() after analyze(A) [-].
+  void factorize_analyzed(int ways = 2, int min_size = 1000);
+  /// After analyze(): the sum over L's columns of their entry count (below the diagonal)
+  /// squared, the numeric factorisation's multiply-adds to leading order [-].
+  double symbolic_flops() const { return symbolic_flops_; }
+  /// After analyze(): the fill-reducing order, the k-th pivot is row order()[k] [-].
+  const Eigen::VectorXi& order() const { return m_Pinv.indices(); }
+
   /// b := (A + shift I)^-1 b [b's units over A's], in place. After a split factorisation the
   /// forward substitution runs by the same subtrees on the threads, then the top rows, each
   /// way's part of them added in way order; the backward one the top rows first, then the
@@ -118,6 +129,8 @@ class TreeLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
   bool top_dense_ = false;                 ///< the split chose a dense top (see top_was_dense())
   std::vector<double> schur_;      ///< the top's Schur complement, then its U (top_dense()) [A's]
   StageTimers* timers_ = nullptr;  ///< see set_timers()
+  CholMatrixType permuted_;        ///< P A P^T's upper triangle (analyze())
+  double symbolic_flops_ = 0;      ///< see symbolic_flops() [-]
 };
 
 }  // namespace mpmcd

@@ -388,3 +388,63 @@ TEST(ActiveSet, OneNearlyMasslessSlotDoesNotSlowTheOthers) {
     }
   }
 }
+
+namespace {
+// Sets MPMCD_SUPERNODAL (the factorisation's choice: "0" TreeLdlt, "1" supernodal) for a scope,
+// unset after.
+class ForcedFactorisation {
+ public:
+  explicit ForcedFactorisation(const char* value) { set(value); }
+  void set(const char* value) const { setenv("MPMCD_SUPERNODAL", value, 1); }
+  ~ForcedFactorisation() { unsetenv("MPMCD_SUPERNODAL"); }
+  ForcedFactorisation(const ForcedFactorisation&) = delete;
+  ForcedFactorisation& operator=(const ForcedFactorisation&) = delete;
+};
+}  // namespace
+
+TEST(ActiveSet, SupernodalFactorisationGivesTheImpulsesOfTheSimplicialOne) {
+  // Two grains of 300 slots each with a dense compliance: W is dense (675 contacts, 470 active)
+  // and its factor's columns long, as in the dense 3D packings where the solver takes the
+  // supernodal factorisation (CHOLMOD; docs/contact.md, "The supernodal factorisation"), forced
+  // here (this problem is below the size the rule wants); then a bordered solve on that
+  // factorisation (two contacts opened, two closed). Both must give the impulses of the
+  // simplicial LDL^T (TreeLdlt, forced).
+  const auto base = two_grain_problem(300, 4, 23);
+  const contact::GsSettings s = tight();
+  contact::ActiveSetCache cache;
+  const ForcedFactorisation supernodal("1");
+  const auto first = solved_with_cache(base, s, cache);
+  EXPECT_TRUE(cache.factor.supernodal);
+  EXPECT_LT(complementarity_violation(first), 1e-10);
+  auto simplicial = base;
+  contact::ActiveSetCache simplicial_cache;
+  supernodal.set("0");
+  ASSERT_TRUE(contact::solve_active_set(simplicial, s, &simplicial_cache).converged);
+  EXPECT_FALSE(simplicial_cache.factor.supernodal);
+  supernodal.set("1");
+  expect_same_net_impulses(first, simplicial, 1e-9);
+
+  auto next = first;
+  int lifted = 0, closed = 0;
+  for (auto& c : next.contacts) {
+    const double pn = c.impulse.dot(c.normal);
+    if (c.a < 0 && pn > 0 && lifted < 2) {
+      next.slots[c.b].v_free[1] += 5.0;
+      ++lifted;
+    } else if (c.a >= 0 && pn == 0 && closed < 2) {
+      c.gap = -2.0 * next.dt;
+      ++closed;
+    }
+  }
+  ASSERT_EQ(lifted, 2);
+  ASSERT_EQ(closed, 2);
+  auto scratch = next;
+  const auto rc = contact::solve_active_set(next, s, &cache);
+  ASSERT_TRUE(rc.converged);
+  EXPECT_TRUE(cache.factor.supernodal);
+  EXPECT_FALSE(cache.factor.owners.empty());  // bordered columns were made
+  supernodal.set("0");
+  ASSERT_TRUE(contact::solve_active_set(scratch, s).converged);
+  EXPECT_LT(complementarity_violation(next), 1e-10);
+  expect_same_net_impulses(next, scratch, 1e-9);
+}
