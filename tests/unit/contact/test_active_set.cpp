@@ -241,6 +241,24 @@ contact::Problem<2> solved_with_cache(const contact::Problem<2>& base, const con
   EXPECT_TRUE(contact::solve_active_set(solved, s, &cache).converged);
   return solved;
 }
+
+// Opens two contacts of a solved two_grain_problem and closes two: the first two loaded wall
+// contacts' slots lifted off the wall, the gaps of two open grain-grain contacts closed; false
+// if it found fewer.
+bool open_two_close_two(contact::Problem<2>& p) {
+  int lifted = 0, closed = 0;
+  for (auto& c : p.contacts) {
+    const double pn = c.impulse.dot(c.normal);
+    if (c.a < 0 && pn > 0 && lifted < 2) {
+      p.slots[c.b].v_free[1] += 5.0;
+      ++lifted;
+    } else if (c.a >= 0 && pn == 0 && closed < 2) {
+      c.gap = -2.0 * p.dt;
+      ++closed;
+    }
+  }
+  return lifted == 2 && closed == 2;
+}
 }  // namespace
 
 TEST(ActiveSet, ColumnsOfChangedGroupsMadeAgainGiveTheMatrixMadeAnew) {
@@ -295,22 +313,8 @@ TEST(ActiveSet, BorderedSolveMatchesAFreshFactorisation) {
   const contact::GsSettings s = tight();
   contact::ActiveSetCache cache;
   auto first = solved_with_cache(base, s, cache);
-  // Open two contacts and close two: the first two wall contacts' slots lifted off the wall, the
-  // gaps of two open grain-grain contacts closed.
   auto next = first;
-  int lifted = 0, closed = 0;
-  for (auto& c : next.contacts) {
-    const double pn = c.impulse.dot(c.normal);
-    if (c.a < 0 && pn > 0 && lifted < 2) {
-      next.slots[c.b].v_free[1] += 5.0;
-      ++lifted;
-    } else if (c.a >= 0 && pn == 0 && closed < 2) {
-      c.gap = -2.0 * next.dt;
-      ++closed;
-    }
-  }
-  ASSERT_EQ(lifted, 2);
-  ASSERT_EQ(closed, 2);
+  ASSERT_TRUE(open_two_close_two(next));
   auto scratch = next;
   const auto rc = contact::solve_active_set(next, s, &cache);
   const auto rs = contact::solve_active_set(scratch, s);
@@ -425,19 +429,7 @@ TEST(ActiveSet, SupernodalFactorisationGivesTheImpulsesOfTheSimplicialOne) {
   expect_same_net_impulses(first, simplicial, 1e-9);
 
   auto next = first;
-  int lifted = 0, closed = 0;
-  for (auto& c : next.contacts) {
-    const double pn = c.impulse.dot(c.normal);
-    if (c.a < 0 && pn > 0 && lifted < 2) {
-      next.slots[c.b].v_free[1] += 5.0;
-      ++lifted;
-    } else if (c.a >= 0 && pn == 0 && closed < 2) {
-      c.gap = -2.0 * next.dt;
-      ++closed;
-    }
-  }
-  ASSERT_EQ(lifted, 2);
-  ASSERT_EQ(closed, 2);
+  ASSERT_TRUE(open_two_close_two(next));
   auto scratch = next;
   const auto rc = contact::solve_active_set(next, s, &cache);
   ASSERT_TRUE(rc.converged);
