@@ -153,10 +153,23 @@ class NormalColumns {
 
 template <int Dim>
 NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix, StageTimers* timers) {
+  if (!with_matrix) {
+    NormalSystem sys;
+    const NormalColumns<Dim> cols(p, false, sys);
+    return sys;
+  }
+  Eigen::SparseMatrix<double> W;
+  NormalSystem sys = normal_system_into(p, W, timers);
+  sys.W = std::move(W);
+  return sys;
+}
+
+template <int Dim>
+NormalSystem normal_system_into(const Problem<Dim>& p, Eigen::SparseMatrix<double>& W,
+                                StageTimers* timers) {
   const auto m = static_cast<Eigen::Index>(p.contacts.size());
   NormalSystem sys;
-  const NormalColumns<Dim> cols(p, with_matrix, sys);
-  if (!with_matrix) return sys;
+  const NormalColumns<Dim> cols(p, true, sys);
   // W column by column on the threads, straight into compressed storage; a first pass counts
   // each column's rows.
   std::vector<Eigen::Index> count(static_cast<std::size_t>(m) + 1, 0);
@@ -167,12 +180,16 @@ NormalSystem normal_system(const Problem<Dim>& p, bool with_matrix, StageTimers*
     count[static_cast<std::size_t>(c) + 1] = static_cast<Eigen::Index>(cols.count(c));
   counting.done();
   for (std::size_t c = 0; c < static_cast<std::size_t>(m); ++c) count[c + 1] += count[c];
-  sys.W.resize(m, m);
-  sys.W.resizeNonZeros(count.back());
+  // resize() keeps W's storage (Eigen empties it without freeing), so an assembly of no more
+  // entries than the last writes into pages already mapped; a larger one reserves 10 % more.
+  W.resize(m, m);
+  const Eigen::Index nnz = count.back();
+  if (W.data().allocatedSize() < nnz) W.reserve(nnz + nnz / 10);
+  W.resizeNonZeros(nnz);
   for (Eigen::Index c = 0; c <= m; ++c)
-    sys.W.outerIndexPtr()[c] = static_cast<int>(count[static_cast<std::size_t>(c)]);
-  int* const rows = sys.W.innerIndexPtr();
-  double* const vals = sys.W.valuePtr();
+    W.outerIndexPtr()[c] = static_cast<int>(count[static_cast<std::size_t>(c)]);
+  int* const rows = W.innerIndexPtr();
+  double* const vals = W.valuePtr();
   ThreadedRegion filling(timers, threads);
 #pragma omp parallel for schedule(dynamic, 64) if (threads)
   for (Eigen::Index c = 0; c < m; ++c)
@@ -748,13 +765,15 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
                          cache->stale.size() == problem.groups.size() &&
                          cache->W.cols() == static_cast<Eigen::Index>(problem.contacts.size()) &&
                          cache->normals == normals;
-    NormalSystem sys = refresh
-                           ? refresh_normal_system(problem, cache->stale, cache->W, settings.timers)
-                           : normal_system(problem, !reuse, settings.timers);
+    // A new W is written into the storage of the last one (in a dense 3D packing W is about a
+    // gigabyte, and fresh storage faults its pages in at every assembly).
     ActiveSetCache local;
     ActiveSetCache& kept = cache ? *cache : local;
+    NormalSystem sys = refresh
+                           ? refresh_normal_system(problem, cache->stale, cache->W, settings.timers)
+                       : reuse ? normal_system(problem, false, settings.timers)
+                               : normal_system_into(problem, kept.W, settings.timers);
     if (!reuse) {
-      if (!refresh) kept.W = std::move(sys.W);
       kept.factor.active.clear();
       kept.valid = true;
       kept.pattern = true;
@@ -895,10 +914,12 @@ GsResult solve_active_set(Problem<Dim>& problem, const GsSettings& settings,
   return result;
 }
 
-#define MPMCD_INSTANTIATE(D)                                                                  \
-  template NormalSystem normal_system<D>(const Problem<D>&, bool, StageTimers*);              \
-  template NormalSystem refresh_normal_system<D>(const Problem<D>&, const std::vector<char>&, \
-                                                 Eigen::SparseMatrix<double>&, StageTimers*); \
+#define MPMCD_INSTANTIATE(D)                                                                   \
+  template NormalSystem normal_system<D>(const Problem<D>&, bool, StageTimers*);               \
+  template NormalSystem normal_system_into<D>(const Problem<D>&, Eigen::SparseMatrix<double>&, \
+                                              StageTimers*);                                   \
+  template NormalSystem refresh_normal_system<D>(const Problem<D>&, const std::vector<char>&,  \
+                                                 Eigen::SparseMatrix<double>&, StageTimers*);  \
   template GsResult solve_active_set<D>(Problem<D>&, const GsSettings&, ActiveSetCache*);
 MPMCD_INSTANTIATE(2)
 MPMCD_INSTANTIATE(3)

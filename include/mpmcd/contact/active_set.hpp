@@ -33,6 +33,13 @@ template <int Dim>
 NormalSystem normal_system(const Problem<Dim>& problem, bool with_matrix = true,
                            StageTimers* timers = nullptr);
 
+/// normal_system with W written into `W` (b and p returned, their W left empty), whose storage
+/// is reused when it holds enough entries: W of a dense 3D packing is about a gigabyte, and
+/// fresh storage would fault its pages in at every assembly.
+template <int Dim>
+NormalSystem normal_system_into(const Problem<Dim>& problem, Eigen::SparseMatrix<double>& W,
+                                StageTimers* timers = nullptr);
+
 /// Column by column as normal_system makes them, W's columns of the contacts that touch a group
 /// marked in `stale` (per group: its G changed), written in place into `W`, which must be the
 /// problem's W but for those groups (the same contacts, slots and normals); the other columns
