@@ -6,7 +6,7 @@
 // with modified Newton (Settings::modified_newton, "modified" = 1), also with CPDI shape functions
 // and affine P2G ("cpdi_affine" = 1); and one Gauss-Seidel
 // solve of a synthetic lumped problem on 1 and 2 threads (BM_GaussSeidelNodes); the active set's
-// LDL^T on the threads (BM_TreeLdlt).
+// LDL^T on the threads (BM_TreeLdlt) and against the supernodal Cholesky (BM_ActiveSetFactor).
 //   ./build/release/bench/bench_contact --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -14,6 +14,7 @@
 #include "../tests/support/contact_problems.hpp"
 #include "../tests/support/sparse_matrices.hpp"
 #include "mpmcd/core/dense_lapack.hpp"
+#include "mpmcd/core/supernodal_llt.hpp"
 #include "mpmcd/core/tree_ldlt.hpp"
 #include "mpmcd/mpm/solver.hpp"
 #include "slice_300.hpp"
@@ -115,6 +116,38 @@ void BM_TreeLdlt(benchmark::State& state) {
   state.counters["split_speedup"] = ldlt.split_speedup();
 }
 
+// The active set's two factorisations of W_AA + delta I (docs/contact.md, "The supernodal
+// factorisation") on a dense-block matrix like a packing's (grain_blocks_matrix: `groups` grains
+// in a row of `per_grain` contacts of their own and a third as many shared with the next, every
+// pair on a grain coupled at rank 3; a few large grains give the long columns of a dense 3D
+// packing's factor, many small ones the 2D case), the ordering and analysis included: `supernodal`
+// 0 is TreeLdlt split for 2 ways, 1 CHOLMOD's supernodal Cholesky with TreeLdlt's order (OpenBLAS
+// on one thread), on `threads` threads. Counters: rows, L's entries and its mean column
+// (multiply-adds over entries).
+void BM_ActiveSetFactor(benchmark::State& state) {
+  const int groups = static_cast<int>(state.range(0)), per = static_cast<int>(state.range(1));
+  const bool supernodal = state.range(2) != 0;
+  omp_set_num_threads(static_cast<int>(state.range(3)));
+  const Eigen::SparseMatrix<double> A =
+      test_support::grain_blocks_matrix(groups, per, per / 3, 3, 1e-4, 7);
+  TreeLdlt ldlt;
+  SupernodalLlt llt;
+  ldlt.setShift(1e-9);
+  for (auto _ : state) {
+    ldlt.analyze(A);
+    if (supernodal) {
+      if (!llt.compute(A, 1e-9, ldlt.order().data())) state.SkipWithError("not SPD");
+    } else {
+      ldlt.factorize_analyzed(2, 1000);
+      benchmark::DoNotOptimize(ldlt.vectorD().data());
+    }
+  }
+  const double nnz = static_cast<double>(ldlt.matrixL().nestedExpression().nonZeros());
+  state.counters["rows"] = static_cast<double>(A.rows());
+  state.counters["L_nonzeros"] = nnz;
+  state.counters["mean_column"] = ldlt.symbolic_flops() / nnz;
+}
+
 // The dense top's kernel (dense::cholesky_upper_on_threads, blocks of 96 rows) on an n x n SPD
 // matrix, copy included, on `threads` threads; the counter GFlops is n^3 / 3 over the time, and
 // the label OpenBLAS's kernels (docs/parallel.md, "The top rows as a dense Schur complement").
@@ -151,6 +184,15 @@ BENCHMARK(BM_TreeLdlt)
     ->Args({72, 2, 1})
     ->Args({72, 2, 2})
     ->Args({72, 4, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK(BM_ActiveSetFactor)
+    ->ArgNames({"groups", "per_grain", "supernodal", "threads"})
+    ->Args({160, 120, 0, 2})
+    ->Args({160, 120, 1, 2})
+    ->Args({24, 720, 0, 2})
+    ->Args({24, 720, 1, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
