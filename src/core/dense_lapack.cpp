@@ -88,10 +88,6 @@ bool kernels_reselected() {
   return kernels_selected;
 }
 
-void use_one_blas_thread() {
-  one_thread();
-}
-
 bool cholesky_in_place(Eigen::MatrixXd& A) {
   one_thread();
   const int n = as_int(A.rows()), lda = std::max(1, n);

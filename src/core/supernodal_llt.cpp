@@ -1,7 +1,5 @@
 #include "mpmcd/core/supernodal_llt.hpp"
 
-#include "mpmcd/core/dense_lapack.hpp"
-
 #include <omp.h>
 #include <suitesparse/cholmod.h>
 
@@ -83,7 +81,6 @@ SupernodalLlt::SupernodalLlt(SupernodalLlt&&) noexcept = default;
 SupernodalLlt& SupernodalLlt::operator=(SupernodalLlt&&) noexcept = default;
 
 bool SupernodalLlt::compute(const Eigen::SparseMatrix<double>& A, double shift, const int* order) {
-  dense::use_one_blas_thread();
   const OneOpenMpThread one;
   if (!impl_) impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;

@@ -15,10 +15,6 @@ const char* kernels();
 /// a CPU with AVX2 or AVX-512 that it does not know, and OPENBLAS_CORETYPE was not set.
 bool kernels_reselected();
 
-/// Sets OpenBLAS to one thread (once, keeping the OpenMP default thread count): for callers of
-/// BLAS through other libraries (CHOLMOD, supernodal_llt.hpp).
-void use_one_blas_thread();
-
 /// In-place Cholesky factorisation A = L L^T of the symmetric matrix whose lower triangle A holds
 /// (LAPACK dpotrf); L in the lower triangle, the strict upper triangle untouched. False when A is
 /// not positive definite (A's content is then unspecified).

@@ -6,8 +6,8 @@
 /// columns are long (the active set's W_AA in a dense 3D packing: every pair of contacts on one
 /// sphere couples, a mean of ~1,000 entries per column of L) the dense kernels run at several
 /// times the speed of a simplicial up-looking loop (TreeLdlt); docs/contact.md, "The supernodal
-/// factorisation". OpenBLAS runs on one thread here (dense_lapack.hpp), so the bits do not depend
-/// on the thread count.
+/// factorisation". OpenBLAS runs on one thread here (the OpenMP default set to 1 around each
+/// CHOLMOD call), so the bits do not depend on the thread count.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
